@@ -1,0 +1,214 @@
+// CosseratRod: a discrete Cosserat rod (stretch, shear, bend, twist) composed at compile time
+// from policy classes, integrated with PyElastica 1.0's discrete scheme so both agree to
+// round-off (see internal_forces.hpp for the operators and integrators.hpp for the step order).
+//
+//   using Rod = manisoft::CosseratRod<double, manisoft::damping::AnalyticalLinear,
+//                                     manisoft::bc::ClampedBase,
+//                                     manisoft::integrator::PositionVerlet,
+//                                     manisoft::forcing::Gravity, manisoft::forcing::ElementTorques>;
+//   Rod rod(manisoft::RodParameters<double>{}, 2e-4, manisoft::damping::AnalyticalLinear<double>{0.1});
+//   rod.forcing<manisoft::forcing::ElementTorques>().set(torques);   // n x 3, material frame
+//   rod.step();
+//
+// Guarantees: the constructor refuses bad parameters and a time step above the explicit
+// stability limit (unless constructed with `allow_unstable_timestep`); a step allocates no heap
+// memory; a step that meets a non-finite load or produces a non-finite or diverging state throws
+// manisoft::Error naming the step and the element, and the state before that step is kept.
+#pragma once
+
+#include <tuple>
+#include <type_traits>
+
+#include "manisoft/rod/boundary.hpp"
+#include "manisoft/rod/damping.hpp"
+#include "manisoft/rod/energies.hpp"
+#include "manisoft/rod/forcing.hpp"
+#include "manisoft/rod/integrators.hpp"
+#include "manisoft/rod/internal_forces.hpp"
+#include "manisoft/rod/kinematics.hpp"
+
+namespace manisoft {
+
+/// Tag: build a rod even though its time step exceeds the explicit stability limit.
+struct AllowUnstableTimestep {};
+inline constexpr AllowUnstableTimestep allow_unstable_timestep{};
+
+template <typename Scalar, template <class> class Damping = damping::None, template <class> class Boundary = bc::ClampedBase,
+          typename Integrator = integrator::PositionVerlet, template <class> class... Forcings>
+class CosseratRod {
+  static_assert(std::is_floating_point_v<Scalar>, "CosseratRod needs a floating-point scalar");
+
+ public:
+  using Model = RodModel<Scalar>;
+  using State = RodState<Scalar>;
+  using Workspace = RodWorkspace<Scalar>;
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using DampingPolicy = Damping<Scalar>;
+  using BoundaryPolicy = Boundary<Scalar>;
+
+  /// A straight rod at rest described by `params`, stepped with `dt`.
+  CosseratRod(const RodParameters<Scalar>& params, Scalar dt, DampingPolicy damping = {}, Forcings<Scalar>... forcings)
+      : CosseratRod(make_rod_model(params), make_straight_rod_state(params), dt, false, std::move(damping), std::move(forcings)...) {}
+
+  /// As above, with every forcing policy default-constructed (set them with forcing<F>()).
+  CosseratRod(const RodParameters<Scalar>& params, Scalar dt, DampingPolicy damping)
+    requires(sizeof...(Forcings) > 0)
+      : CosseratRod(make_rod_model(params), make_straight_rod_state(params), dt, false, std::move(damping), Forcings<Scalar>{}...) {}
+
+  /// As above, without the stability check (the caller owns the consequences).
+  CosseratRod(AllowUnstableTimestep, const RodParameters<Scalar>& params, Scalar dt, DampingPolicy damping = {},
+              Forcings<Scalar>... forcings)
+      : CosseratRod(make_rod_model(params), make_straight_rod_state(params), dt, true, std::move(damping), std::move(forcings)...) {}
+
+  /// Any model and initial state (e.g. a pre-bent rod); the state must match the model's size.
+  CosseratRod(Model model, State initial, Scalar dt, bool allow_unstable, DampingPolicy damping = {}, Forcings<Scalar>... forcings)
+      : model_(std::move(model)), state_(std::move(initial)), workspace_(model_.n_elements), dt_(dt),
+        damping_(std::move(damping)), forcings_(std::move(forcings)...) {
+    detail::require_positive("dt", dt);
+    check_state_shape(state_);
+    const Scalar limit = model_.stable_timestep_limit();
+    if (!allow_unstable && dt > limit)
+      detail::fail("dt = ", dt, " s exceeds the explicit stability limit ", limit, " s of this rod (n_elements = ",
+                   model_.n_elements, ", min element length ", model_.rest_lengths.minCoeff(),
+                   " m); use a smaller dt, or construct with manisoft::allow_unstable_timestep to override");
+    damping_.setup(model_, dt_);
+    std::apply([&](auto&... f) { (f.setup(model_), ...); }, forcings_);
+    boundary_.setup(state_);
+    backup_ = state_;
+    compute_internal_forces_and_torques(model_, state_, workspace_);
+  }
+
+  // ---- stepping
+  /// Advances the rod by dt. Throws manisoft::Error (state unchanged) on non-finite loads or state.
+  void step() {
+    backup_ = state_;
+    try {
+      Integrator::step(*this, dt_);
+      check_state();
+    } catch (...) {
+      state_ = backup_;
+      throw;
+    }
+    ++step_count_;
+    state_.external_forces.setZero();
+    state_.external_torques.setZero();
+  }
+  void step(int count) {
+    for (int i = 0; i < count; ++i) step();
+  }
+
+  // ---- stages used by the integrator policies
+  void kinematic(Scalar h) {
+    update_kinematics(state_, h);
+    state_.time += h;
+    boundary_.constrain_values(state_);
+  }
+  void dynamic(Scalar h) {
+    compute_internal_forces_and_torques(model_, state_, workspace_);
+    workspace_.applied_forces = state_.external_forces;
+    workspace_.applied_torques = state_.external_torques;
+    std::apply([&](const auto&... f) { (f.apply(model_, state_, workspace_, workspace_.applied_forces, workspace_.applied_torques), ...); },
+               forcings_);
+    check_loads();
+    for (int c = 0; c < 3; ++c) {
+      Scalar* MANISOFT_RESTRICT v = detail::column(state_.velocities, c);
+      const Scalar* MANISOFT_RESTRICT fi = workspace_.internal_forces.col(c).data();
+      const Scalar* MANISOFT_RESTRICT fa = workspace_.applied_forces.col(c).data();
+      const Scalar* MANISOFT_RESTRICT m = model_.node_masses.data();
+      for (int k = 0; k <= model_.n_elements; ++k) v[k] += h * (fi[k] + fa[k]) / m[k];
+      Scalar* MANISOFT_RESTRICT w = detail::column(state_.angular_velocities, c);
+      const Scalar* MANISOFT_RESTRICT ti = workspace_.internal_torques.col(c).data();
+      const Scalar* MANISOFT_RESTRICT ta = workspace_.applied_torques.col(c).data();
+      const Scalar* MANISOFT_RESTRICT j = model_.inertia.col(c).data();
+      const Scalar* MANISOFT_RESTRICT e = workspace_.dilatation.data();
+      for (int k = 0; k < model_.n_elements; ++k) w[k] += h * (ti[k] + ta[k]) / j[k] * e[k];
+    }
+    boundary_.constrain_rates(state_);
+  }
+  void dampen() { damping_.dampen(model_, state_, workspace_); }
+
+  // ---- access
+  const Model& model() const { return model_; }
+  const State& state() const { return state_; }
+  /// Mutable state: set initial conditions, or add external loads for the next step
+  /// (external_forces on nodes in the lab frame, external_torques on elements in the material frame).
+  State& state() { return state_; }
+  const Workspace& workspace() const { return workspace_; }
+  Scalar dt() const { return dt_; }
+  Scalar time() const { return state_.time; }
+  long step_count() const { return step_count_; }
+  int n_elements() const { return model_.n_elements; }
+  Vector3 tip_position() const { return state_.tip_position(); }
+  DampingPolicy& damping() { return damping_; }
+  BoundaryPolicy& boundary() { return boundary_; }
+  template <template <class> class F>
+  F<Scalar>& forcing() { return std::get<F<Scalar>>(forcings_); }
+  template <template <class> class F>
+  const F<Scalar>& forcing() const { return std::get<F<Scalar>>(forcings_); }
+
+  /// Recomputes strains, stresses, internal forces and torques of the current state into the
+  /// workspace (after a step they hold the values of the last force evaluation).
+  const Workspace& refresh() {
+    compute_internal_forces_and_torques(model_, state_, workspace_);
+    return workspace_;
+  }
+  /// Energies of the current state; gravity is taken from a Gravity forcing if the rod has one.
+  RodEnergies<Scalar> energies() {
+    Vector3 g = Vector3::Zero();
+    if constexpr ((std::is_same_v<Forcings<Scalar>, forcing::Gravity<Scalar>> || ...)) g = forcing<forcing::Gravity>().acceleration;
+    return compute_energies(model_, state_, workspace_, g);
+  }
+
+ private:
+  void check_state_shape(const State& s) const {
+    const int n = model_.n_elements;
+    if (s.positions.rows() != n + 1 || s.velocities.rows() != n + 1 || s.directors.rows() != n ||
+        s.angular_velocities.rows() != n || s.external_forces.rows() != n + 1 || s.external_torques.rows() != n)
+      detail::fail("rod state does not match the model: expected ", n + 1, " nodes and ", n, " elements");
+  }
+  void check_loads() const {
+    if (std::isfinite(workspace_.applied_forces.sum()) && std::isfinite(workspace_.applied_torques.sum())) return;
+    for (int k = 0; k < workspace_.applied_forces.rows(); ++k)
+      if (!workspace_.applied_forces.row(k).allFinite())
+        detail::fail("step ", step_count_, ": non-finite external force (", workspace_.applied_forces.row(k), ") on node ", k,
+                     " refused; the rod keeps its state before the step");
+    for (int k = 0; k < workspace_.applied_torques.rows(); ++k)
+      if (!workspace_.applied_torques.row(k).allFinite())
+        detail::fail("step ", step_count_, ": non-finite external torque (", workspace_.applied_torques.row(k), ") on element ", k,
+                     " refused; the rod keeps its state before the step");
+    detail::fail("step ", step_count_, ": external loads overflow");
+  }
+  void check_state() const {
+    const Scalar sum = state_.positions.sum() + state_.velocities.sum() + state_.angular_velocities.sum() + state_.directors.sum();
+    const Scalar e_min = workspace_.dilatation.minCoeff(), e_max = workspace_.dilatation.maxCoeff();
+    const bool strain_ok = e_min > Scalar(0.01) && e_max < Scalar(100);
+    if (std::isfinite(sum) && strain_ok) return;
+    const int n = model_.n_elements;
+    for (int k = 0; k <= n; ++k)
+      if (!state_.positions.row(k).allFinite() || !state_.velocities.row(k).allFinite())
+        detail::fail("step ", step_count_, " (t = ", backup_.time, " s) produced a non-finite state at node ", k,
+                     " (position ", state_.positions.row(k), ", velocity ", state_.velocities.row(k),
+                     "); the rod keeps its state before the step. Is dt below the stability limit and are the loads bounded?");
+    for (int k = 0; k < n; ++k)
+      if (!state_.angular_velocities.row(k).allFinite() || !state_.directors.row(k).allFinite())
+        detail::fail("step ", step_count_, " (t = ", backup_.time, " s) produced a non-finite state at element ", k,
+                     " (angular velocity ", state_.angular_velocities.row(k), "); the rod keeps its state before the step");
+    int worst = 0;
+    for (int k = 0; k < n; ++k)
+      if (std::abs(std::log(workspace_.dilatation[k])) > std::abs(std::log(workspace_.dilatation[worst]))) worst = k;
+    detail::fail("step ", step_count_, " (t = ", backup_.time, " s): the rod diverged, element ", worst, " has dilatation ",
+                 workspace_.dilatation[worst], " (allowed 0.01 .. 100); the rod keeps its state before the step");
+  }
+
+  Model model_;
+  State state_;
+  State backup_;
+  Workspace workspace_;
+  Scalar dt_;
+  long step_count_ = 0;
+  DampingPolicy damping_;
+  BoundaryPolicy boundary_;
+  std::tuple<Forcings<Scalar>...> forcings_;
+};
+
+}  // namespace manisoft

@@ -1,0 +1,51 @@
+// Small-angle forms of the rotation functions a rod step needs, with the library call kept for
+// large arguments. Per-step rotation angles are tiny (|omega| dt << 1), and the truncated series
+// below are exact to round-off inside their ranges (first omitted term < 1e-17 relative), so
+// the step avoids ~12 maths-library calls per element (DESIGN.md section 7).
+#pragma once
+
+#include <cmath>
+
+namespace manisoft::detail {
+
+/// Range of theta^2 inside which the rotation series are used.
+template <typename Scalar>
+inline constexpr Scalar small_angle_sq = Scalar(1e-2);
+
+/// sin(theta)/theta and (1 - cos(theta))/theta^2 from theta^2 (Rodrigues coefficients).
+/// Series: sum (-1)^k theta^2k / (2k+1)!  and  sum (-1)^k theta^2k / (2k+2)!  (|theta| < 0.1).
+template <typename Scalar>
+inline void rodrigues_coefficients(Scalar theta_sq, Scalar& sin_over_theta, Scalar& one_minus_cos_over_theta_sq) {
+  if (theta_sq < small_angle_sq<Scalar>) {
+    const Scalar t = theta_sq;
+    sin_over_theta = Scalar(1) - t / 6 * (Scalar(1) - t / 20 * (Scalar(1) - t / 42 * (Scalar(1) - t / 72)));
+    one_minus_cos_over_theta_sq = Scalar(0.5) * (Scalar(1) - t / 12 * (Scalar(1) - t / 30 * (Scalar(1) - t / 56 * (Scalar(1) - t / 90))));
+  } else {
+    const Scalar theta = std::sqrt(theta_sq);
+    sin_over_theta = std::sin(theta) / theta;
+    one_minus_cos_over_theta_sq = (Scalar(1) - std::cos(theta)) / theta_sq;
+  }
+}
+
+/// theta / sin(theta) of a rotation given s = sin(theta) >= 0 and c = cos(theta).
+/// Series of asin(s)/s = sum (2k)! / (4^k (k!)^2 (2k+1)) s^2k for s < 0.1 and c > 0; else atan2.
+/// Unlike acos of the trace this stays accurate for tiny angles, also in float.
+template <typename Scalar>
+inline Scalar theta_over_sin(Scalar s, Scalar c) {
+  const Scalar s2 = s * s;
+  if (c > 0 && s2 < small_angle_sq<Scalar>) {
+    return Scalar(1) + s2 * (Scalar(1) / 6 + s2 * (Scalar(3) / 40 + s2 * (Scalar(5) / 112 + s2 * (Scalar(35) / 1152 + s2 * (Scalar(63) / 2816 + s2 * (Scalar(231) / 13312))))));
+  }
+  return std::atan2(s, c) / s;
+}
+
+/// exp(x) for the small damping exponents of a step (|x| < 0.1: Taylor to x^9, error < 1e-17).
+template <typename Scalar>
+inline Scalar exp_small(Scalar x) {
+  if (x > Scalar(-0.1) && x < Scalar(0.1)) {
+    return Scalar(1) + x * (Scalar(1) + x / 2 * (Scalar(1) + x / 3 * (Scalar(1) + x / 4 * (Scalar(1) + x / 5 * (Scalar(1) + x / 6 * (Scalar(1) + x / 7 * (Scalar(1) + x / 8 * (Scalar(1) + x / 9))))))));
+  }
+  return std::exp(x);
+}
+
+}  // namespace manisoft::detail
