@@ -46,22 +46,25 @@ class CosseratRod {
   using DampingPolicy = Damping<Scalar>;
   using BoundaryPolicy = Boundary<Scalar>;
 
-  /// A straight rod at rest described by `params`, stepped with `dt`.
-  CosseratRod(const RodParameters<Scalar>& params, Scalar dt, DampingPolicy damping = {}, Forcings<Scalar>... forcings)
-      : CosseratRod(make_rod_model(params), make_straight_rod_state(params), dt, false, std::move(damping), std::move(forcings)...) {}
-
-  /// As above, with every forcing policy default-constructed (set them with forcing<F>()).
+  /// A straight rod at rest described by `params`, stepped with `dt`. Policies not given are
+  /// default-constructed (reach them later with damping() and forcing<F>()).
+  CosseratRod(const RodParameters<Scalar>& params, Scalar dt) : CosseratRod(params, dt, DampingPolicy{}) {}
   CosseratRod(const RodParameters<Scalar>& params, Scalar dt, DampingPolicy damping)
     requires(sizeof...(Forcings) > 0)
-      : CosseratRod(make_rod_model(params), make_straight_rod_state(params), dt, false, std::move(damping), Forcings<Scalar>{}...) {}
+      : CosseratRod(params, dt, std::move(damping), Forcings<Scalar>{}...) {}
+  CosseratRod(const RodParameters<Scalar>& params, Scalar dt, DampingPolicy damping, Forcings<Scalar>... forcings)
+      : CosseratRod(make_rod_model(params), make_straight_rod_state(params), dt, false, std::move(damping), std::move(forcings)...) {}
 
-  /// As above, without the stability check (the caller owns the consequences).
-  CosseratRod(AllowUnstableTimestep, const RodParameters<Scalar>& params, Scalar dt, DampingPolicy damping = {},
-              Forcings<Scalar>... forcings)
+  /// The same, without the stability check (the caller owns the consequences).
+  CosseratRod(AllowUnstableTimestep tag, const RodParameters<Scalar>& params, Scalar dt) : CosseratRod(tag, params, dt, DampingPolicy{}) {}
+  CosseratRod(AllowUnstableTimestep tag, const RodParameters<Scalar>& params, Scalar dt, DampingPolicy damping)
+    requires(sizeof...(Forcings) > 0)
+      : CosseratRod(tag, params, dt, std::move(damping), Forcings<Scalar>{}...) {}
+  CosseratRod(AllowUnstableTimestep, const RodParameters<Scalar>& params, Scalar dt, DampingPolicy damping, Forcings<Scalar>... forcings)
       : CosseratRod(make_rod_model(params), make_straight_rod_state(params), dt, true, std::move(damping), std::move(forcings)...) {}
 
   /// Any model and initial state (e.g. a pre-bent rod); the state must match the model's size.
-  CosseratRod(Model model, State initial, Scalar dt, bool allow_unstable, DampingPolicy damping = {}, Forcings<Scalar>... forcings)
+  CosseratRod(Model model, State initial, Scalar dt, bool allow_unstable, DampingPolicy damping, Forcings<Scalar>... forcings)
       : model_(std::move(model)), state_(std::move(initial)), workspace_(model_.n_elements), dt_(dt),
         damping_(std::move(damping)), forcings_(std::move(forcings)...) {
     detail::require_positive("dt", dt);
