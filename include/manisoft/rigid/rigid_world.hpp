@@ -1,0 +1,647 @@
+// RigidWorld: rigid bodies with contact and Coulomb friction, stepped at the rod's timestep.
+// Broad phase: FCL's DynamicAABBTreeCollisionManager over fattened AABBs (re-queried only when a
+// fat box had to move). Narrow phase: narrow_phase.hpp, re-run for a pair only when its bodies have
+// moved by more than half the contact margin since the last run; in between, the persistent
+// manifolds (contact_manifold.hpp) extrapolate their separations. Solver: contact_solver.hpp.
+// Islands of touching bodies that stay still for `time_to_sleep` are put to sleep (skipped) and
+// wake when a force is applied, a velocity or pose is set, or a moving body touches them.
+// Step order (symplectic Euler): contacts -> prepare -> v += h M^-1 f -> warm start -> solve ->
+// x += h v, q += h/2 w q -> relax -> restitution -> store.
+// Determinism: everything is iterated in body/geometry index order; broad-phase pairs are sorted.
+// Allocation: after the first steps (buffers grown to their working size) step() allocates only on
+// the FCL fallback path (sphere/capsule vs cylinder/mesh: FCL result vectors) and when the set of
+// overlapping pairs grows beyond its previous maximum.
+#pragma once
+
+#include "manisoft/contact/contact_solver.hpp"
+#include "manisoft/contact/narrow_phase.hpp"
+#include "manisoft/rigid/rigid_body.hpp"
+
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
+
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+namespace manisoft {
+
+struct RigidWorldSettings {
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};
+  double contact_margin{0.002};      ///< m: speculative contact distance (points reported up to it)
+  double contact_hertz{0};           ///< soft contact stiffness; 0 = 0.125 / dt
+  double contact_damping_ratio{10};  ///< Box2D v3's default (overdamped: no bounce from correction)
+  double max_push_velocity{1.0};     ///< m/s: cap on penetration recovery speed
+  int solve_iterations{4};
+  int relax_iterations{2};
+  double restitution_threshold{0.2};  ///< m/s: slower impacts are inelastic
+  bool warm_start{true};
+  bool enable_sleep{true};
+  double sleep_linear_velocity{0.005};  ///< m/s
+  double sleep_angular_velocity{0.05};  ///< rad/s
+  double time_to_sleep{0.5};            ///< s
+};
+
+/// A contact of a query capsule (e.g. a rod element) with a body of the world.
+struct CapsuleContact {
+  BodyId body{0};
+  std::uint32_t geom{0};
+  Eigen::Vector3d position{Eigen::Vector3d::Zero()};  ///< world, between the surfaces
+  Eigen::Vector3d normal{Eigen::Vector3d::UnitZ()};   ///< unit, from the capsule into the body
+  double separation{0};                               ///< < 0: penetration depth
+  double segment_parameter{0};  ///< where along p0 -> p1 (0..1) the contact lies
+};
+
+/// One collision geometry: a primitive attached to a body (a compound has several).
+struct RigidGeom {
+  BodyId body{0};
+  contact::Pose local;  ///< relative to the body's centre-of-mass frame
+  contact::CollisionShape shape;
+  contact::Vec3 fat_lo{contact::Vec3::Zero()}, fat_hi{contact::Vec3::Zero()};
+};
+
+namespace detail {
+
+/// An FCL collision object whose broad-phase AABB we set ourselves (fattened by a margin).
+class FatCollisionObject : public fcl::CollisionObjectd {
+ public:
+  using fcl::CollisionObjectd::CollisionObjectd;
+  void set_aabb(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+    aabb.min_ = lo;
+    aabb.max_ = hi;
+  }
+};
+
+}  // namespace detail
+
+class RigidWorld {
+ public:
+  using Vec3 = Eigen::Vector3d;
+  using Mat3 = Eigen::Matrix3d;
+  using Quat = Eigen::Quaterniond;
+
+  explicit RigidWorld(RigidWorldSettings settings = {}) : settings_(std::move(settings)) {
+    if (!settings_.gravity.allFinite()) ::manisoft::detail::fail("RigidWorldSettings::gravity must be finite");
+    ::manisoft::detail::require_positive("RigidWorldSettings::contact_margin", settings_.contact_margin);
+    ::manisoft::detail::require_non_negative("RigidWorldSettings::contact_hertz", settings_.contact_hertz);
+    ::manisoft::detail::require_non_negative("RigidWorldSettings::contact_damping_ratio", settings_.contact_damping_ratio);
+    ::manisoft::detail::require_positive("RigidWorldSettings::max_push_velocity", settings_.max_push_velocity);
+    if (settings_.solve_iterations < 1 || settings_.relax_iterations < 0) {
+      ::manisoft::detail::fail("RigidWorldSettings: solve_iterations = ", settings_.solve_iterations,
+                               " must be >= 1 and relax_iterations = ", settings_.relax_iterations, " >= 0");
+    }
+    manager_ = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
+  }
+
+  RigidWorld(const RigidWorld&) = delete;
+  RigidWorld& operator=(const RigidWorld&) = delete;
+
+  // ---- building -------------------------------------------------------------------------------
+
+  /// Adds a body; returns its id (0, 1, 2, ... in order of addition).
+  BodyId add_body(const RigidBodyDesc& desc) {
+    const auto id = static_cast<BodyId>(models_.size());
+    RigidBodyModel model = make_body_model(desc, id);
+    RigidBodyState state;
+    state.orientation = desc.orientation.normalized();
+    state.rotation = state.orientation.toRotationMatrix();
+    state.position = desc.position + state.rotation * model.center_of_mass;
+    if (!desc.is_static) {
+      state.linear_velocity = desc.linear_velocity;
+      state.angular_velocity = desc.angular_velocity;
+    }
+    model.first_geom = static_cast<std::uint32_t>(geoms_.size());
+    auto add_geom = [&](const PrimitiveShape<double>& prim, const Vec3& pos, const Quat& q) {
+      RigidGeom g;
+      g.body = id;
+      Vec3 mesh_origin = Vec3::Zero();
+      g.local.rotation = q.normalized().toRotationMatrix();
+      g.local.translation = pos - model.center_of_mass;
+      if (std::holds_alternative<ConvexMesh<double>>(prim)) {
+        // Mesh vertices are re-centred on the body's centre of mass: the geom sits at the COM.
+        mesh_origin = model.center_of_mass - pos;  // in the part frame when q = identity
+        mesh_origin = g.local.rotation.transpose() * (model.center_of_mass - pos);
+        g.local.translation = Vec3::Zero();
+      }
+      validate_primitive(prim, id, desc.name);
+      g.shape = contact::make_collision_shape(prim, mesh_origin);
+      model.bounding_radius = std::max(model.bounding_radius, g.local.translation.norm() + g.shape.bounding_radius);
+      geoms_.push_back(std::move(g));
+    };
+    std::visit(
+        [&](const auto& s) {
+          using S = std::decay_t<decltype(s)>;
+          if constexpr (std::is_same_v<S, Compound<double>>) {
+            for (const auto& part : s.parts) add_geom(part.shape, part.position, part.orientation);
+          } else {
+            add_geom(PrimitiveShape<double>(s), Vec3::Zero(), Quat::Identity());
+          }
+        },
+        desc.shape);
+    model.geom_count = static_cast<std::uint32_t>(geoms_.size()) - model.first_geom;
+    models_.push_back(std::move(model));
+    states_.push_back(state);
+    for (std::uint32_t g = models_.back().first_geom; g < geoms_.size(); ++g) {
+      auto obj = std::make_unique<detail::FatCollisionObject>(geoms_[g].shape.fcl_geometry);
+      obj->setUserData(reinterpret_cast<void*>(static_cast<std::uintptr_t>(g) + 1));  // 0 = query object
+      fcl_objects_.push_back(std::move(obj));
+      refresh_fat_bounds(g, true);
+      manager_->registerObject(fcl_objects_[g].get());
+    }
+    broadphase_dirty_ = true;
+    return id;
+  }
+
+  // ---- stepping -------------------------------------------------------------------------------
+
+  /// Advances the world by `dt` seconds. Throws manisoft::Error (world left at its previous
+  /// state) if a body's state becomes non-finite.
+  void step(double dt) {
+    if (!std::isfinite(dt) || !(dt > 0)) ::manisoft::detail::fail("RigidWorld::step: dt = ", dt, " must be finite and > 0");
+    previous_states_ = states_;
+    contact::ContactSolverSettings cs;
+    cs.h = dt;
+    const double hertz = settings_.contact_hertz > 0 ? std::min(settings_.contact_hertz, 0.25 / dt) : 0.125 / dt;
+    cs.soft = contact::SoftParameters::make(hertz, settings_.contact_damping_ratio, dt);
+    cs.max_push_velocity = settings_.max_push_velocity;
+    cs.restitution_threshold = settings_.restitution_threshold;
+    cs.warm_start = settings_.warm_start;
+
+    update_broadphase();
+    update_narrowphase();
+    update_islands();
+
+    // Solver bodies: awake dynamic bodies move; static and sleeping ones are immovable.
+    solver_bodies_.resize(models_.size());
+    for (std::size_t i = 0; i < models_.size(); ++i) {
+      auto& b = solver_bodies_[i];
+      const auto& m = models_[i];
+      const auto& s = states_[i];
+      b.v = s.linear_velocity;
+      b.w = s.angular_velocity;
+      if (m.is_static || !s.awake) {
+        b.inv_mass = 0;
+        b.inv_inertia.setZero();
+      } else {
+        b.inv_mass = m.inverse_mass;
+        b.inv_inertia = s.rotation * m.inverse_inertia * s.rotation.transpose();
+      }
+    }
+    for (auto& m : manifolds_) {
+      m.active = m.count > 0 && (is_moving(m.body_a) || is_moving(m.body_b));
+    }
+    contact::prepare_contacts(manifolds_, states_, solver_bodies_);
+    integrate_velocities(dt);
+    if (settings_.warm_start) contact::warm_start_contacts(manifolds_, solver_bodies_);
+    for (int it = 0; it < settings_.solve_iterations; ++it) contact::solve_contacts(manifolds_, solver_bodies_, cs, true);
+    integrate_positions(dt);
+    contact::update_after_position_integration(manifolds_, solver_bodies_, cs);
+    for (int it = 0; it < settings_.relax_iterations; ++it) contact::solve_contacts(manifolds_, solver_bodies_, cs, false);
+    contact::apply_restitution(manifolds_, solver_bodies_, cs);
+    contact::store_impulses(manifolds_, cs);
+    finish_step(dt);
+  }
+
+  // ---- queries --------------------------------------------------------------------------------
+
+  std::size_t body_count() const { return models_.size(); }
+  const RigidBodyModel& model(BodyId id) const { return models_.at(id); }
+  const RigidBodyState& state(BodyId id) const { return states_.at(id); }
+  const RigidWorldSettings& settings() const { return settings_; }
+  double time() const { return time_; }
+  std::uint64_t step_count() const { return step_count_; }
+
+  /// Position of the body's shape frame origin (as given in RigidBodyDesc::position).
+  Vec3 position(BodyId id) const {
+    const auto& s = states_.at(id);
+    return s.position - s.rotation * models_[id].center_of_mass;
+  }
+  Vec3 center_of_mass(BodyId id) const { return states_.at(id).position; }
+  Quat orientation(BodyId id) const { return states_.at(id).orientation; }
+  Vec3 linear_velocity(BodyId id) const { return states_.at(id).linear_velocity; }
+  Vec3 angular_velocity(BodyId id) const { return states_.at(id).angular_velocity; }
+  bool is_awake(BodyId id) const { return states_.at(id).awake; }
+  /// Velocity of the body's material point at world position p.
+  Vec3 velocity_at_point(BodyId id, const Vec3& p) const {
+    const auto& s = states_.at(id);
+    return s.linear_velocity + s.angular_velocity.cross(p - s.position);
+  }
+  /// Kinetic plus gravitational potential energy of all dynamic bodies (J).
+  double mechanical_energy() const {
+    double e = 0;
+    for (std::size_t i = 0; i < models_.size(); ++i) {
+      if (models_[i].is_static) continue;
+      const auto& s = states_[i];
+      const Vec3 wb = s.rotation.transpose() * s.angular_velocity;
+      e += 0.5 * models_[i].mass * s.linear_velocity.squaredNorm() + 0.5 * wb.dot(models_[i].inertia * wb) -
+           models_[i].mass * settings_.gravity.dot(s.position);
+    }
+    return e;
+  }
+  const std::vector<contact::ContactManifold>& manifolds() const { return manifolds_; }
+  const std::vector<RigidGeom>& geoms() const { return geoms_; }
+  /// Number of contact points with separation <= 0 (touching) this step.
+  std::size_t touching_point_count() const {
+    std::size_t n = 0;
+    for (const auto& m : manifolds_) for (int k = 0; k < m.count; ++k) n += m.points[static_cast<std::size_t>(k)].separation <= 0;
+    return n;
+  }
+
+  /// Contacts of the capsule p0-p1 of radius `radius` (e.g. a rod element, moving every step)
+  /// with every body's geometry, reported up to separation `margin`. `out` is cleared and filled
+  /// in (body, geometry) order; its capacity is reused.
+  void query_capsule(const Vec3& p0, const Vec3& p1, double radius, double margin, std::vector<CapsuleContact>& out) {
+    out.clear();
+    if (!p0.allFinite() || !p1.allFinite() || !std::isfinite(radius) || radius < 0 || !std::isfinite(margin) || margin < 0) {
+      ::manisoft::detail::fail("RigidWorld::query_capsule: end points, radius = ", radius, " and margin = ", margin,
+                               " must be finite (radius, margin >= 0)");
+    }
+    contact::CollisionShape capsule;
+    capsule.kind = contact::ShapeKind::capsule;
+    capsule.radius = radius;
+    const Vec3 axis = p1 - p0;
+    const double len = axis.norm();
+    capsule.half_length = 0.5 * len;
+    contact::Pose pose;
+    pose.translation = 0.5 * (p0 + p1);
+    if (len > 0) {
+      pose.rotation = Quat::FromTwoVectors(Vec3::UnitZ(), axis / len).toRotationMatrix();
+    }
+    if (!query_geometry_) {
+      query_geometry_ = std::make_shared<fcl::Capsuled>(radius, len);
+      query_object_ = std::make_unique<detail::FatCollisionObject>(query_geometry_);
+      query_object_->setUserData(nullptr);  // FCL leaves user data uninitialised
+    }
+    query_geometry_->radius = radius;  // reused: no allocation per query
+    query_geometry_->lz = len;
+    query_geometry_->computeLocalAABB();
+    const Vec3 pad = Vec3::Constant(radius + margin);
+    query_object_->set_aabb(p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad);
+    capsule.fcl_geometry = query_geometry_;
+    query_candidates_.clear();
+    manager_->collide(query_object_.get(), &query_candidates_, &collect_query);
+    std::sort(query_candidates_.begin(), query_candidates_.end());
+    for (const auto g : query_candidates_) {
+      const auto& geom = geoms_[g];
+      const contact::Pose gp = geom_pose(g);
+      if (!contact::collide(capsule, pose, geom.shape, gp, margin, contact_scratch_, scratch_)) continue;
+      for (int k = 0; k < contact_scratch_.count; ++k) {
+        const auto& cp = contact_scratch_.points[static_cast<std::size_t>(k)];
+        CapsuleContact c;
+        c.body = geom.body;
+        c.geom = g;
+        c.position = cp.position;
+        c.normal = contact_scratch_.normal;
+        c.separation = cp.separation;
+        c.segment_parameter = len > 0 ? std::clamp((cp.position - p0).dot(axis) / (len * len), 0.0, 1.0) : 0.0;
+        out.push_back(c);
+      }
+    }
+  }
+
+  // ---- external actions (rod contact, gripper, spring coupling) --------------------------------
+
+  /// Adds a force (N, world) at the centre of mass for the next step. Wakes the body.
+  void add_force(BodyId id, const Vec3& force) { add_force_and_torque(id, force, Vec3::Zero()); }
+  /// Adds a torque (N m, world) for the next step. Wakes the body.
+  void add_torque(BodyId id, const Vec3& torque) { add_force_and_torque(id, Vec3::Zero(), torque); }
+  /// Adds a force (N, world) applied at world point p for the next step: f and (p - x_com) x f.
+  void add_force_at_point(BodyId id, const Vec3& force, const Vec3& point) {
+    if (!point.allFinite()) ::manisoft::detail::fail("rigid body ", id, ": force application point is not finite");
+    add_force_and_torque(id, force, (point - states_.at(id).position).cross(force));
+  }
+  void add_force_and_torque(BodyId id, const Vec3& force, const Vec3& torque) {
+    check_id(id);
+    if (!force.allFinite() || !torque.allFinite()) {
+      ::manisoft::detail::fail("rigid body ", id, describe(id), ": external force (", force.transpose(), ") or torque (",
+                               torque.transpose(), ") is not finite");
+    }
+    if (models_[id].is_static) return;
+    auto& s = states_[id];
+    s.force += force;
+    s.torque += torque;
+    if (force.squaredNorm() > 0 || torque.squaredNorm() > 0) s.sleep_time = 0;
+  }
+  void set_velocity(BodyId id, const Vec3& linear, const Vec3& angular) {
+    check_id(id);
+    if (!linear.allFinite() || !angular.allFinite()) ::manisoft::detail::fail("rigid body ", id, describe(id), ": velocity is not finite");
+    if (models_[id].is_static) ::manisoft::detail::fail("rigid body ", id, describe(id), " is static: its velocity cannot be set");
+    states_[id].linear_velocity = linear;
+    states_[id].angular_velocity = angular;
+    states_[id].sleep_time = 0;
+  }
+  /// Teleports a body (shape-frame origin and orientation). Its cached contacts are re-detected.
+  void set_pose(BodyId id, const Vec3& position, const Quat& orientation) {
+    check_id(id);
+    if (!position.allFinite() || !orientation.coeffs().allFinite() || orientation.norm() < 1e-9) {
+      ::manisoft::detail::fail("rigid body ", id, describe(id), ": pose is not finite");
+    }
+    auto& s = states_[id];
+    s.orientation = orientation.normalized();
+    s.rotation = s.orientation.toRotationMatrix();
+    s.position = position + s.rotation * models_[id].center_of_mass;
+    s.travel += 1e3;  // forces re-detection of every pair of this body
+    s.sleep_time = 0;
+    for (std::uint32_t g = models_[id].first_geom; g < models_[id].first_geom + models_[id].geom_count; ++g) {
+      refresh_fat_bounds(g, true);
+      manager_->update(fcl_objects_[g].get());
+    }
+    broadphase_dirty_ = true;
+  }
+
+  /// World placement of geometry g.
+  contact::Pose geom_pose(std::uint32_t g) const {
+    const auto& geom = geoms_[g];
+    const auto& s = states_[geom.body];
+    contact::Pose p;
+    p.rotation = s.rotation * geom.local.rotation;
+    p.translation = s.position + s.rotation * geom.local.translation;
+    return p;
+  }
+
+ private:
+  static bool collect_pair(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
+    auto* pairs = static_cast<std::vector<std::uint64_t>*>(data);
+    auto a = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(o1->getUserData()) - 1);
+    auto b = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(o2->getUserData()) - 1);
+    if (a > b) std::swap(a, b);
+    pairs->push_back((std::uint64_t(a) << 32) | b);
+    return false;
+  }
+  static bool collect_query(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
+    auto* out = static_cast<std::vector<std::uint32_t>*>(data);
+    // One of the two is the query object (user data 0); the other carries geometry index + 1.
+    const auto tag = reinterpret_cast<std::uintptr_t>(o1->getUserData()) + reinterpret_cast<std::uintptr_t>(o2->getUserData());
+    if (tag > 0) out->push_back(static_cast<std::uint32_t>(tag - 1));
+    return false;
+  }
+
+  std::string describe(BodyId id) const {
+    return models_[id].name.empty() ? std::string() : " ('" + models_[id].name + "')";
+  }
+  void check_id(BodyId id) const {
+    if (id >= models_.size()) ::manisoft::detail::fail("rigid body id ", id, " out of range (", models_.size(), " bodies)");
+  }
+  bool is_moving(BodyId id) const { return !models_[id].is_static && states_[id].awake; }
+
+  static void validate_primitive(const PrimitiveShape<double>& prim, BodyId id, const std::string& name) {
+    const std::string who = "rigid body " + std::to_string(id) + (name.empty() ? "" : " ('" + name + "')");
+    std::visit(
+        [&](const auto& s) {
+          using S = std::decay_t<decltype(s)>;
+          if constexpr (std::is_same_v<S, Box<double>>) {
+            for (int i = 0; i < 3; ++i) ::manisoft::detail::require_positive((who + ": box half extent").c_str(), s.half_extents[i]);
+          } else if constexpr (std::is_same_v<S, Sphere<double>>) {
+            ::manisoft::detail::require_positive((who + ": sphere radius").c_str(), s.radius);
+          } else if constexpr (std::is_same_v<S, Capsule<double>>) {
+            ::manisoft::detail::require_positive((who + ": capsule radius").c_str(), s.radius);
+            ::manisoft::detail::require_non_negative((who + ": capsule half_length").c_str(), s.half_length);
+          } else if constexpr (std::is_same_v<S, Cylinder<double>>) {
+            ::manisoft::detail::require_positive((who + ": cylinder radius").c_str(), s.radius);
+            ::manisoft::detail::require_positive((who + ": cylinder half_height").c_str(), s.half_height);
+          }
+        },
+        prim);
+  }
+
+  /// Recomputes the fat AABB of geometry g if its margin-inflated bounds left it (or if forced).
+  bool refresh_fat_bounds(std::uint32_t g, bool force) {
+    auto& geom = geoms_[g];
+    Vec3 lo, hi;
+    geom.shape.bounds(geom_pose(g), lo, hi);
+    const Vec3 m = Vec3::Constant(settings_.contact_margin);
+    lo -= m;
+    hi += m;
+    if (!force && (lo.array() >= geom.fat_lo.array()).all() && (hi.array() <= geom.fat_hi.array()).all()) return false;
+    const Vec3 slack = Vec3::Constant(models_[geom.body].is_static ? 0.0 : 2.0 * settings_.contact_margin + 0.002);
+    geom.fat_lo = lo - slack;
+    geom.fat_hi = hi + slack;
+    fcl_objects_[g]->set_aabb(geom.fat_lo, geom.fat_hi);
+    return true;
+  }
+
+  void update_broadphase() {
+    for (std::uint32_t g = 0; g < geoms_.size(); ++g) {
+      if (!is_moving(geoms_[g].body)) continue;
+      if (refresh_fat_bounds(g, false)) {
+        manager_->update(fcl_objects_[g].get());
+        broadphase_dirty_ = true;
+      }
+    }
+    if (!broadphase_dirty_) return;
+    broadphase_dirty_ = false;
+    pairs_.clear();
+    manager_->collide(&pairs_, &collect_pair);
+    std::sort(pairs_.begin(), pairs_.end());
+    // Merge into the sorted manifold list, keeping the cache of persisting pairs.
+    next_manifolds_.clear();
+    std::size_t old = 0;
+    for (const auto key : pairs_) {
+      const auto ga = static_cast<std::uint32_t>(key >> 32), gb = static_cast<std::uint32_t>(key & 0xffffffffu);
+      const BodyId ba = geoms_[ga].body, bb = geoms_[gb].body;
+      if (ba == bb || (models_[ba].is_static && models_[bb].is_static)) continue;
+      while (old < manifolds_.size() && manifolds_[old].key() < key) ++old;
+      if (old < manifolds_.size() && manifolds_[old].key() == key) {
+        next_manifolds_.push_back(manifolds_[old]);
+        continue;
+      }
+      contact::ContactManifold m;
+      m.geom_a = ga;
+      m.geom_b = gb;
+      m.body_a = ba;
+      m.body_b = bb;
+      m.friction = std::sqrt(models_[ba].friction * models_[bb].friction);
+      m.restitution = std::max(models_[ba].restitution, models_[bb].restitution);
+      m.fresh = true;
+      next_manifolds_.push_back(m);
+    }
+    std::swap(manifolds_, next_manifolds_);
+  }
+
+  void update_narrowphase() {
+    const double redetect = 0.5 * settings_.contact_margin;
+    for (auto& m : manifolds_) {
+      const auto& sa = states_[m.body_a];
+      const auto& sb = states_[m.body_b];
+      if (!m.fresh && (sa.travel - m.travel_a) + (sb.travel - m.travel_b) <= redetect) continue;
+      m.fresh = false;
+      m.travel_a = sa.travel;
+      m.travel_b = sb.travel;
+      auto& c = contact_scratch_;
+      if (!contact::collide(geoms_[m.geom_a].shape, geom_pose(m.geom_a), geoms_[m.geom_b].shape, geom_pose(m.geom_b),
+                            settings_.contact_margin, c, scratch_)) {
+        c.clear();
+      }
+      rebuild_manifold(m, c);
+    }
+  }
+
+  /// Replaces the points of m by the new contact set, matching them to cached points by
+  /// proximity to carry impulses and friction drift over.
+  void rebuild_manifold(contact::ContactManifold& m, const contact::ContactSet& c) {
+    const auto& sa = states_[m.body_a];
+    const auto& sb = states_[m.body_b];
+    const Vec3 old_normal = (m.owner == contact::NormalOwner::shape_a ? sa.rotation : sb.rotation) * m.normal_local;
+    std::array<Vec3, contact::kMaxContactPoints> old_pos;
+    for (int k = 0; k < m.count; ++k) {
+      const auto& p = m.points[static_cast<std::size_t>(k)];
+      old_pos[static_cast<std::size_t>(k)] = 0.5 * (sa.position + sa.rotation * p.anchor_a + sb.position + sb.rotation * p.anchor_b);
+    }
+    const auto old_points = m.points;
+    const int old_count = m.count;
+    std::array<bool, contact::kMaxContactPoints> used{};
+    const bool same_normal = old_count > 0 && old_normal.dot(c.normal) > 0.95;
+    const double match2 = std::pow(std::max(settings_.contact_margin, 1e-3), 2);
+    m.count = c.count;
+    m.owner = c.normal_owner;
+    m.normal_local = (c.normal_owner == contact::NormalOwner::shape_a ? sa.rotation : sb.rotation).transpose() * c.normal;
+    for (int k = 0; k < c.count; ++k) {
+      const auto& cp = c.points[static_cast<std::size_t>(k)];
+      contact::ManifoldPoint p;
+      p.anchor_a = sa.rotation.transpose() * (cp.position - sa.position);
+      p.anchor_b = sb.rotation.transpose() * (cp.position - sb.position);
+      p.base_separation = cp.separation;
+      if (same_normal) {
+        int best = -1;
+        double best_d2 = match2;
+        for (int j = 0; j < old_count; ++j) {
+          if (used[static_cast<std::size_t>(j)]) continue;
+          const double d2 = (old_pos[static_cast<std::size_t>(j)] - cp.position).squaredNorm();
+          if (d2 < best_d2) { best_d2 = d2; best = j; }
+        }
+        if (best >= 0) {
+          used[static_cast<std::size_t>(best)] = true;
+          const auto& o = old_points[static_cast<std::size_t>(best)];
+          p.normal_impulse = o.normal_impulse;
+          p.tangent_impulse = o.tangent_impulse;
+          p.drift = o.drift;
+        }
+      }
+      m.points[static_cast<std::size_t>(k)] = p;
+    }
+  }
+
+  /// Islands of bodies joined by contact manifolds; an island sleeps when all its bodies have been
+  /// still for time_to_sleep (and wakes as soon as one has not).
+  void update_islands() {
+    const std::size_t n = models_.size();
+    if (!settings_.enable_sleep) {
+      for (auto& s : states_) s.awake = true;
+      return;
+    }
+    parent_.resize(n);
+    island_min_time_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) parent_[i] = static_cast<std::uint32_t>(i);
+    auto find = [&](std::uint32_t i) {
+      while (parent_[i] != i) { parent_[i] = parent_[parent_[i]]; i = parent_[i]; }
+      return i;
+    };
+    for (const auto& m : manifolds_) {
+      if (m.count == 0 || models_[m.body_a].is_static || models_[m.body_b].is_static) continue;
+      const auto ra = find(m.body_a), rb = find(m.body_b);
+      if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
+    }
+    for (std::size_t i = 0; i < n; ++i) island_min_time_[i] = INFINITY;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (models_[i].is_static) continue;
+      const auto r = find(static_cast<std::uint32_t>(i));
+      island_min_time_[r] = std::min(island_min_time_[r], states_[i].sleep_time);
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (models_[i].is_static) continue;
+      auto& s = states_[i];
+      const bool awake = island_min_time_[find(static_cast<std::uint32_t>(i))] < settings_.time_to_sleep;
+      if (!awake && s.awake) {
+        s.linear_velocity.setZero();
+        s.angular_velocity.setZero();
+      }
+      s.awake = awake;
+    }
+  }
+
+  void integrate_velocities(double h) {
+    for (std::size_t i = 0; i < models_.size(); ++i) {
+      if (!is_moving(static_cast<BodyId>(i))) continue;
+      const auto& m = models_[i];
+      auto& s = states_[i];
+      auto& b = solver_bodies_[i];
+      b.v += h * (settings_.gravity + m.inverse_mass * s.force);
+      // Angular: external torque explicitly, then the gyroscopic term implicitly in body axes,
+      // one Newton step on f(w) = I (w - w0) + h w x I w = 0 (Catto, GDC 2015).
+      Vec3 wb = s.rotation.transpose() * (b.w + h * (b.inv_inertia * s.torque));
+      const Vec3 iw = m.inertia * wb;
+      const Vec3 f = h * wb.cross(iw);
+      if (f.squaredNorm() > 0) {
+        Mat3 skew_w, skew_iw;
+        skew_w << 0, -wb.z(), wb.y(), wb.z(), 0, -wb.x(), -wb.y(), wb.x(), 0;
+        skew_iw << 0, -iw.z(), iw.y(), iw.z(), 0, -iw.x(), -iw.y(), iw.x(), 0;
+        const Mat3 jac = m.inertia + h * (skew_w * m.inertia - skew_iw);
+        wb -= jac.partialPivLu().solve(f);
+      }
+      b.w = s.rotation * wb;
+    }
+  }
+
+  void integrate_positions(double h) {
+    for (std::size_t i = 0; i < models_.size(); ++i) {
+      if (!is_moving(static_cast<BodyId>(i))) continue;
+      auto& s = states_[i];
+      const auto& b = solver_bodies_[i];
+      s.position += h * b.v;
+      const Quat dq(0.0, 0.5 * h * b.w.x(), 0.5 * h * b.w.y(), 0.5 * h * b.w.z());
+      s.orientation.coeffs() += (dq * s.orientation).coeffs();
+      s.orientation.normalize();
+      s.rotation = s.orientation.toRotationMatrix();
+    }
+  }
+
+  void finish_step(double h) {
+    for (std::size_t i = 0; i < models_.size(); ++i) {
+      auto& s = states_[i];
+      s.force.setZero();
+      s.torque.setZero();
+      if (!is_moving(static_cast<BodyId>(i))) continue;
+      const auto& b = solver_bodies_[i];
+      s.linear_velocity = b.v;
+      s.angular_velocity = b.w;
+      if (!s.position.allFinite() || !s.orientation.coeffs().allFinite() || !b.v.allFinite() || !b.w.allFinite()) {
+        const auto bad = s;
+        states_ = previous_states_;
+        ::manisoft::detail::fail("rigid body ", i, describe(static_cast<BodyId>(i)), " has a non-finite state at step ",
+                                 step_count_ + 1, " (t = ", time_ + h, " s): position (", bad.position.transpose(),
+                                 "), velocity (", bad.linear_velocity.transpose(), "), angular velocity (",
+                                 bad.angular_velocity.transpose(), "); the world keeps its previous state");
+      }
+      const double speed = s.linear_velocity.norm(), spin = s.angular_velocity.norm();
+      s.travel += h * (speed + spin * models_[i].bounding_radius);
+      if (speed < settings_.sleep_linear_velocity && spin < settings_.sleep_angular_velocity) {
+        s.sleep_time += h;
+      } else {
+        s.sleep_time = 0;
+      }
+    }
+    time_ += h;
+    ++step_count_;
+  }
+
+  RigidWorldSettings settings_;
+  std::vector<RigidBodyModel> models_;
+  std::vector<RigidBodyState> states_, previous_states_;
+  std::vector<RigidGeom> geoms_;
+  std::vector<std::unique_ptr<detail::FatCollisionObject>> fcl_objects_;
+  std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> manager_;
+  bool broadphase_dirty_{true};
+  std::vector<std::uint64_t> pairs_;
+  std::vector<contact::ContactManifold> manifolds_, next_manifolds_;
+  std::vector<contact::SolverBody> solver_bodies_;
+  std::vector<std::uint32_t> parent_;
+  std::vector<double> island_min_time_;
+  contact::ContactSet contact_scratch_;
+  contact::NarrowPhaseScratch scratch_;
+  std::shared_ptr<fcl::Capsuled> query_geometry_;
+  std::unique_ptr<detail::FatCollisionObject> query_object_;
+  std::vector<std::uint32_t> query_candidates_;
+  double time_{0};
+  std::uint64_t step_count_{0};
+};
+
+}  // namespace manisoft
