@@ -118,12 +118,14 @@ class CosseratRod {
       const Scalar* MANISOFT_RESTRICT fi = workspace_.internal_forces.col(c).data();
       const Scalar* MANISOFT_RESTRICT fa = workspace_.applied_forces.col(c).data();
       const Scalar* MANISOFT_RESTRICT m = model_.node_masses.data();
+      MANISOFT_VECTORIZE
       for (int k = 0; k <= model_.n_elements; ++k) v[k] += h * (fi[k] + fa[k]) / m[k];
       Scalar* MANISOFT_RESTRICT w = detail::column(state_.angular_velocities, c);
       const Scalar* MANISOFT_RESTRICT ti = workspace_.internal_torques.col(c).data();
       const Scalar* MANISOFT_RESTRICT ta = workspace_.applied_torques.col(c).data();
       const Scalar* MANISOFT_RESTRICT j = model_.inertia.col(c).data();
       const Scalar* MANISOFT_RESTRICT e = workspace_.dilatation.data();
+      MANISOFT_VECTORIZE
       for (int k = 0; k < model_.n_elements; ++k) w[k] += h * (ti[k] + ta[k]) / j[k] * e[k];
     }
     boundary_.constrain_rates(state_);

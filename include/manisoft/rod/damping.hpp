@@ -40,15 +40,26 @@ struct AnalyticalLinear {
 
   void dampen(const RodModel<Scalar>& model, RodState<Scalar>& state, const RodWorkspace<Scalar>& ws) const {
     state.velocities *= translational_factor_;
+    // exp(lf e) <= 1; the series serves whenever every exponent is in its range.
+    const Scalar largest = -log_rotational_factor_.minCoeff() * ws.dilatation.maxCoeff();
+    if (largest < Scalar(detail::exp_series_range))
+      dampen_rotation<true>(model, state, ws);
+    else
+      dampen_rotation<false>(model, state, ws);
+  }
+
+ private:
+  template <bool Series>
+  void dampen_rotation(const RodModel<Scalar>& model, RodState<Scalar>& state, const RodWorkspace<Scalar>& ws) const {
     const Scalar* MANISOFT_RESTRICT e = ws.dilatation.data();
     for (int c = 0; c < 3; ++c) {
       Scalar* MANISOFT_RESTRICT w = detail::column(state.angular_velocities, c);
       const Scalar* MANISOFT_RESTRICT lf = log_rotational_factor_.col(c).data();
-      for (int k = 0; k < model.n_elements; ++k) w[k] *= detail::exp_small(lf[k] * e[k]);
+      MANISOFT_VECTORIZE
+      for (int k = 0; k < model.n_elements; ++k) w[k] *= detail::exp_small<Series>(lf[k] * e[k]);
     }
   }
 
- private:
   Scalar translational_factor_ = 1;
   Eigen::Matrix<Scalar, Eigen::Dynamic, 3> log_rotational_factor_;
 };

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 
 #include "manisoft/rod/rod_model.hpp"
@@ -23,6 +24,14 @@
 #define MANISOFT_RESTRICT __restrict__
 #else
 #define MANISOFT_RESTRICT
+#endif
+// The per-component arrays of one loop never alias each other: let the compiler vectorize.
+#if defined(__clang__)
+#define MANISOFT_VECTORIZE _Pragma("clang loop vectorize(assume_safety)")
+#elif defined(__GNUC__)
+#define MANISOFT_VECTORIZE _Pragma("GCC ivdep")
+#else
+#define MANISOFT_VECTORIZE
 #endif
 
 namespace manisoft {
@@ -35,6 +44,7 @@ struct RodWorkspace {
   using Array3 = Eigen::Matrix<Scalar, Eigen::Dynamic, 3>;
   Array lengths, dilatation, dilatation_rate;  ///< n
   Array voronoi_dilatation;                     ///< n - 1
+  Array rotation_sin, rotation_cos;             ///< n - 1, of the rotation Q_{k+1} Q_k^T
   Array3 tangents;                              ///< n x 3, lab frame
   Array3 sigma;                                 ///< n x 3 shear/stretch strain, material frame
   Array3 internal_stress;                       ///< n x 3 n = S (sigma - sigma0), material frame
@@ -55,6 +65,8 @@ struct RodWorkspace {
     dilatation.setZero(n);
     dilatation_rate.setZero(n);
     voronoi_dilatation.setZero(nv);
+    rotation_sin.setZero(nv);
+    rotation_cos.setZero(nv);
     tangents.setZero(n, 3);
     sigma.setZero(n, 3);
     internal_stress.setZero(n, 3);
@@ -73,6 +85,24 @@ struct RodWorkspace {
 namespace detail {
 template <typename M>
 inline auto* column(M& m, int c) { return m.col(c).data(); }
+
+/// kappa l0v = -theta a = -(theta / sin theta) axial(R - R^T) / 2, in place on the axial vectors.
+template <bool Series, typename Scalar>
+void scale_to_curvature(const RodModel<Scalar>& model, RodWorkspace<Scalar>& ws) {
+  const Scalar* MANISOFT_RESTRICT s = ws.rotation_sin.data();
+  const Scalar* MANISOFT_RESTRICT c = ws.rotation_cos.data();
+  const Scalar* MANISOFT_RESTRICT l0v = model.rest_voronoi_lengths.data();
+  Scalar* MANISOFT_RESTRICT k0 = column(ws.kappa, 0);
+  Scalar* MANISOFT_RESTRICT k1 = column(ws.kappa, 1);
+  Scalar* MANISOFT_RESTRICT k2 = column(ws.kappa, 2);
+  MANISOFT_VECTORIZE
+  for (int k = 0; k < model.n_elements - 1; ++k) {
+    const Scalar scale = Scalar(-0.5) * theta_over_sin<Series>(s[k], c[k]) / l0v[k];
+    k0[k] *= scale;
+    k1[k] *= scale;
+    k2[k] *= scale;
+  }
+}
 }  // namespace detail
 
 /// Shear/stretch and bend/twist strains (sigma, kappa) and the geometric quantities they need.
@@ -98,11 +128,18 @@ void compute_strains(const RodModel<Scalar>& model, const RodState<Scalar>& stat
   Scalar* MANISOFT_RESTRICT s0 = column(ws.sigma, 0);
   Scalar* MANISOFT_RESTRICT s1 = column(ws.sigma, 1);
   Scalar* MANISOFT_RESTRICT s2 = column(ws.sigma, 2);
+  // Square roots go through Eigen's packet sqrt: std::sqrt's errno handling blocks vectorization.
+  MANISOFT_VECTORIZE
   for (int k = 0; k < n; ++k) {
     const Scalar dx = x0[k + 1] - x0[k], dy = x1[k + 1] - x1[k], dz = x2[k + 1] - x2[k];
-    const Scalar l = std::sqrt(dx * dx + dy * dy + dz * dz) + Scalar(1e-14);
+    len[k] = dx * dx + dy * dy + dz * dz;
+  }
+  ws.lengths.array() = ws.lengths.array().sqrt() + Scalar(1e-14);
+  MANISOFT_VECTORIZE
+  for (int k = 0; k < n; ++k) {
+    const Scalar dx = x0[k + 1] - x0[k], dy = x1[k + 1] - x1[k], dz = x2[k + 1] - x2[k];
+    const Scalar l = len[k];
     const Scalar inv_l = Scalar(1) / l;
-    len[k] = l;
     e[k] = l / l0[k];
     const Scalar tx = dx * inv_l, ty = dy * inv_l, tz = dz * inv_l;
     t0[k] = tx;
@@ -120,6 +157,9 @@ void compute_strains(const RodModel<Scalar>& model, const RodState<Scalar>& stat
   Scalar* MANISOFT_RESTRICT k0 = column(ws.kappa, 0);
   Scalar* MANISOFT_RESTRICT k1 = column(ws.kappa, 1);
   Scalar* MANISOFT_RESTRICT k2 = column(ws.kappa, 2);
+  Scalar* MANISOFT_RESTRICT sin_theta = ws.rotation_sin.data();
+  Scalar* MANISOFT_RESTRICT cos_theta = ws.rotation_cos.data();
+  MANISOFT_VECTORIZE
   for (int k = 0; k < n - 1; ++k) {
     eps[k] = Scalar(0.5) * (len[k] + len[k + 1]) / l0v[k];
     // R = Q_{k+1} Q_k^T: R(i, j) = (row i of Q_{k+1}) . (row j of Q_k); axial(R - R^T) = 2 sin(theta) a
@@ -127,15 +167,20 @@ void compute_strains(const RodModel<Scalar>& model, const RodState<Scalar>& stat
       return q[3 * i][k + 1] * q[3 * j][k] + q[3 * i + 1][k + 1] * q[3 * j + 1][k] + q[3 * i + 2][k + 1] * q[3 * j + 2][k];
     };
     const Scalar ax = r(2, 1) - r(1, 2), ay = r(0, 2) - r(2, 0), az = r(1, 0) - r(0, 1);
-    const Scalar trace = r(0, 0) + r(1, 1) + r(2, 2);
-    const Scalar sin_theta = Scalar(0.5) * std::sqrt(ax * ax + ay * ay + az * az);
-    const Scalar cos_theta = Scalar(0.5) * (trace - Scalar(1));
-    // kappa l0v = -theta a = -(theta / sin theta) axial / 2
-    const Scalar scale = Scalar(-0.5) * detail::theta_over_sin(sin_theta, cos_theta) / l0v[k];
-    k0[k] = scale * ax;
-    k1[k] = scale * ay;
-    k2[k] = scale * az;
+    k0[k] = ax;
+    k1[k] = ay;
+    k2[k] = az;
+    const Scalar sin_sq = Scalar(0.25) * (ax * ax + ay * ay + az * az);
+    const Scalar c = Scalar(0.5) * (r(0, 0) + r(1, 1) + r(2, 2) - Scalar(1));
+    sin_theta[k] = sin_sq;
+    cos_theta[k] = c;
   }
+  const Scalar max_sin_sq = ws.rotation_sin.maxCoeff(), min_cos = ws.rotation_cos.minCoeff();
+  ws.rotation_sin.array() = ws.rotation_sin.array().sqrt();
+  if (max_sin_sq < detail::small_angle_sq<Scalar> && min_cos > 0)
+    detail::scale_to_curvature<true>(model, ws);
+  else
+    detail::scale_to_curvature<false>(model, ws);
 }
 
 /// Internal forces (nodes, lab frame) and torques (elements, material frame) of the state.
@@ -163,6 +208,7 @@ void compute_internal_forces_and_torques(const RodModel<Scalar>& model, const Ro
   Scalar* MANISOFT_RESTRICT n_out[3] = {column(ws.internal_stress, 0), column(ws.internal_stress, 1), column(ws.internal_stress, 2)};
   Scalar* MANISOFT_RESTRICT lab[3] = {column(ws.stress_lab, 0), column(ws.stress_lab, 1), column(ws.stress_lab, 2)};
   Scalar* MANISOFT_RESTRICT torque[3] = {column(ws.internal_torques, 0), column(ws.internal_torques, 1), column(ws.internal_torques, 2)};
+  MANISOFT_VECTORIZE
   for (int k = 0; k < n; ++k) {
     const Scalar nx = stiff[0][k] * (s[0][k] - s_rest[0][k]);
     const Scalar ny = stiff[1][k] * (s[1][k] - s_rest[1][k]);
@@ -195,6 +241,7 @@ void compute_internal_forces_and_torques(const RodModel<Scalar>& model, const Ro
   Scalar* MANISOFT_RESTRICT tau[3] = {column(ws.internal_couple, 0), column(ws.internal_couple, 1), column(ws.internal_couple, 2)};
   Scalar* MANISOFT_RESTRICT diff[3] = {column(ws.couple_difference_source, 0), column(ws.couple_difference_source, 1), column(ws.couple_difference_source, 2)};
   Scalar* MANISOFT_RESTRICT avg[3] = {column(ws.couple_average_source, 0), column(ws.couple_average_source, 1), column(ws.couple_average_source, 2)};
+  MANISOFT_VECTORIZE
   for (int k = 0; k < n - 1; ++k) {
     const Scalar bx = bend[0][k] * (kap[0][k] - k_rest[0][k]);
     const Scalar by = bend[1][k] * (kap[1][k] - k_rest[1][k]);
@@ -217,11 +264,13 @@ void compute_internal_forces_and_torques(const RodModel<Scalar>& model, const Ro
     const Scalar* MANISOFT_RESTRICT d = diff[c];
     const Scalar* MANISOFT_RESTRICT a = avg[c];
     out[0] += d[0] + Scalar(0.5) * a[0];
+    MANISOFT_VECTORIZE
     for (int k = 1; k < n - 1; ++k) out[k] += (d[k] - d[k - 1]) + Scalar(0.5) * (a[k] + a[k - 1]);
     out[n - 1] += -d[n - 2] + Scalar(0.5) * a[n - 2];
     Scalar* MANISOFT_RESTRICT f = column(ws.internal_forces, c);
     const Scalar* MANISOFT_RESTRICT sl = lab[c];
     f[0] = sl[0];
+    MANISOFT_VECTORIZE
     for (int k = 1; k < n; ++k) f[k] = sl[k] - sl[k - 1];
     f[n] = -sl[n - 1];
   }

@@ -1,0 +1,34 @@
+// One Cosserat-rod step (gravity + AnalyticalLinear damping 0.1, PositionVerlet, clamped base),
+// the configuration of PyElastica's timing in ../shared/reference/pyelastica/timing.json, at the
+// same n and dt (2e-4 * 20 / n). Run: bench_rod --benchmark_repetitions=9
+#include <benchmark/benchmark.h>
+
+#include "manisoft/rod.hpp"
+
+namespace {
+
+template <typename Scalar>
+void rod_step(benchmark::State& bench) {
+  using Rod = manisoft::CosseratRod<Scalar, manisoft::damping::AnalyticalLinear, manisoft::bc::ClampedBase,
+                                    manisoft::integrator::PositionVerlet, manisoft::forcing::Gravity>;
+  manisoft::RodParameters<Scalar> p;
+  p.n_elements = static_cast<int>(bench.range(0));
+  const Scalar dt = Scalar(2e-4 * 20.0 / p.n_elements);
+  Rod rod(p, dt, manisoft::damping::AnalyticalLinear<Scalar>(Scalar(0.1)));
+  rod.step(500);  // leave the straight state: realistic bending, as PyElastica's warm-up
+  for (auto _ : bench) {
+    rod.step();
+    benchmark::DoNotOptimize(rod.state().positions.data());
+  }
+  bench.counters["us_per_step"] = benchmark::Counter(double(bench.iterations()) * 1e-6,
+                                                     benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void rod_step_double(benchmark::State& s) { rod_step<double>(s); }
+void rod_step_float(benchmark::State& s) { rod_step<float>(s); }
+
+}  // namespace
+
+BENCHMARK(rod_step_double)->Arg(20)->Arg(50)->Arg(100);
+BENCHMARK(rod_step_float)->Arg(20)->Arg(50)->Arg(100);
+BENCHMARK_MAIN();
