@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Installs the Debian packages ManiSoft needs, only those that are missing (needs root or sudo).
+set -euo pipefail
+packages=(cmake make g++ clang libclang-rt-14-dev libeigen3-dev libfcl-dev libccd-dev catch2 libbenchmark-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "installing: ${missing[*]}"
+  sudo_cmd=()
+  [[ $(id -u) -eq 0 ]] || sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
