@@ -69,6 +69,7 @@ class CosseratRod {
         damping_(std::move(damping)), forcings_(std::move(forcings)...) {
     detail::require_positive("dt", dt);
     check_state_shape(state_);
+    model_.update_reciprocals();
     const Scalar limit = model_.stable_timestep_limit();
     if (!allow_unstable && dt > limit)
       detail::fail("dt = ", dt, " s exceeds the explicit stability limit ", limit, " s of this rod (n_elements = ",
@@ -117,16 +118,16 @@ class CosseratRod {
       Scalar* MANISOFT_RESTRICT v = detail::column(state_.velocities, c);
       const Scalar* MANISOFT_RESTRICT fi = workspace_.internal_forces.col(c).data();
       const Scalar* MANISOFT_RESTRICT fa = workspace_.applied_forces.col(c).data();
-      const Scalar* MANISOFT_RESTRICT m = model_.node_masses.data();
+      const Scalar* MANISOFT_RESTRICT inv_m = model_.inv_node_masses.data();
       MANISOFT_VECTORIZE
-      for (int k = 0; k <= model_.n_elements; ++k) v[k] += h * (fi[k] + fa[k]) / m[k];
+      for (int k = 0; k <= model_.n_elements; ++k) v[k] += h * (fi[k] + fa[k]) * inv_m[k];
       Scalar* MANISOFT_RESTRICT w = detail::column(state_.angular_velocities, c);
       const Scalar* MANISOFT_RESTRICT ti = workspace_.internal_torques.col(c).data();
       const Scalar* MANISOFT_RESTRICT ta = workspace_.applied_torques.col(c).data();
-      const Scalar* MANISOFT_RESTRICT j = model_.inertia.col(c).data();
+      const Scalar* MANISOFT_RESTRICT inv_j = model_.inv_inertia.col(c).data();
       const Scalar* MANISOFT_RESTRICT e = workspace_.dilatation.data();
       MANISOFT_VECTORIZE
-      for (int k = 0; k < model_.n_elements; ++k) w[k] += h * (ti[k] + ta[k]) / j[k] * e[k];
+      for (int k = 0; k < model_.n_elements; ++k) w[k] += h * (ti[k] + ta[k]) * inv_j[k] * e[k];
     }
     boundary_.constrain_rates(state_);
   }

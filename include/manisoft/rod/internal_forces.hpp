@@ -91,13 +91,13 @@ template <bool Series, typename Scalar>
 void scale_to_curvature(const RodModel<Scalar>& model, RodWorkspace<Scalar>& ws) {
   const Scalar* MANISOFT_RESTRICT s = ws.rotation_sin.data();
   const Scalar* MANISOFT_RESTRICT c = ws.rotation_cos.data();
-  const Scalar* MANISOFT_RESTRICT l0v = model.rest_voronoi_lengths.data();
+  const Scalar* MANISOFT_RESTRICT inv_l0v = model.inv_rest_voronoi_lengths.data();
   Scalar* MANISOFT_RESTRICT k0 = column(ws.kappa, 0);
   Scalar* MANISOFT_RESTRICT k1 = column(ws.kappa, 1);
   Scalar* MANISOFT_RESTRICT k2 = column(ws.kappa, 2);
   MANISOFT_VECTORIZE
   for (int k = 0; k < model.n_elements - 1; ++k) {
-    const Scalar scale = Scalar(-0.5) * theta_over_sin<Series>(s[k], c[k]) / l0v[k];
+    const Scalar scale = Scalar(-0.5) * theta_over_sin<Series>(s[k], c[k]) * inv_l0v[k];
     k0[k] *= scale;
     k1[k] *= scale;
     k2[k] *= scale;
@@ -118,7 +118,7 @@ void compute_strains(const RodModel<Scalar>& model, const RodState<Scalar>& stat
   const Scalar* MANISOFT_RESTRICT v2 = state.velocities.col(2).data();
   const Scalar* MANISOFT_RESTRICT q[9];
   for (int c = 0; c < 9; ++c) q[c] = state.directors.col(c).data();
-  const Scalar* MANISOFT_RESTRICT l0 = model.rest_lengths.data();
+  const Scalar* MANISOFT_RESTRICT inv_l0 = model.inv_rest_lengths.data();
   Scalar* MANISOFT_RESTRICT len = ws.lengths.data();
   Scalar* MANISOFT_RESTRICT e = ws.dilatation.data();
   Scalar* MANISOFT_RESTRICT edot = ws.dilatation_rate.data();
@@ -140,19 +140,19 @@ void compute_strains(const RodModel<Scalar>& model, const RodState<Scalar>& stat
     const Scalar dx = x0[k + 1] - x0[k], dy = x1[k + 1] - x1[k], dz = x2[k + 1] - x2[k];
     const Scalar l = len[k];
     const Scalar inv_l = Scalar(1) / l;
-    e[k] = l / l0[k];
+    e[k] = l * inv_l0[k];
     const Scalar tx = dx * inv_l, ty = dy * inv_l, tz = dz * inv_l;
     t0[k] = tx;
     t1[k] = ty;
     t2[k] = tz;
     const Scalar dvx = v0[k + 1] - v0[k], dvy = v1[k + 1] - v1[k], dvz = v2[k + 1] - v2[k];
-    edot[k] = (dx * dvx + dy * dvy + dz * dvz) / (l * l0[k]);
+    edot[k] = (dx * dvx + dy * dvy + dz * dvz) * inv_l * inv_l0[k];
     // sigma = e Q t - (0, 0, 1)
     s0[k] = e[k] * (q[0][k] * tx + q[1][k] * ty + q[2][k] * tz);
     s1[k] = e[k] * (q[3][k] * tx + q[4][k] * ty + q[5][k] * tz);
     s2[k] = e[k] * (q[6][k] * tx + q[7][k] * ty + q[8][k] * tz) - Scalar(1);
   }
-  const Scalar* MANISOFT_RESTRICT l0v = model.rest_voronoi_lengths.data();
+  const Scalar* MANISOFT_RESTRICT inv_l0v = model.inv_rest_voronoi_lengths.data();
   Scalar* MANISOFT_RESTRICT eps = ws.voronoi_dilatation.data();
   Scalar* MANISOFT_RESTRICT k0 = column(ws.kappa, 0);
   Scalar* MANISOFT_RESTRICT k1 = column(ws.kappa, 1);
@@ -161,7 +161,7 @@ void compute_strains(const RodModel<Scalar>& model, const RodState<Scalar>& stat
   Scalar* MANISOFT_RESTRICT cos_theta = ws.rotation_cos.data();
   MANISOFT_VECTORIZE
   for (int k = 0; k < n - 1; ++k) {
-    eps[k] = Scalar(0.5) * (len[k] + len[k + 1]) / l0v[k];
+    eps[k] = Scalar(0.5) * (len[k] + len[k + 1]) * inv_l0v[k];
     // R = Q_{k+1} Q_k^T: R(i, j) = (row i of Q_{k+1}) . (row j of Q_k); axial(R - R^T) = 2 sin(theta) a
     auto r = [&](int i, int j) {
       return q[3 * i][k + 1] * q[3 * j][k] + q[3 * i + 1][k + 1] * q[3 * j + 1][k] + q[3 * i + 2][k + 1] * q[3 * j + 2][k];

@@ -65,6 +65,18 @@ struct RodModel {
   Array cross_section_area;    ///< A, n
   Array second_moment_min;     ///< smallest area second moment min(I1, I2, I3), n
 
+  // Reciprocals of the above, used by the step instead of divisions (filled by update_reciprocals).
+  Array inv_rest_lengths, inv_rest_voronoi_lengths, inv_node_masses;
+  Array3 inv_inertia;
+
+  /// Recomputes the reciprocal arrays; call after editing the model's arrays.
+  void update_reciprocals() {
+    inv_rest_lengths = rest_lengths.cwiseInverse();
+    inv_rest_voronoi_lengths = rest_voronoi_lengths.cwiseInverse();
+    inv_node_masses = node_masses.cwiseInverse();
+    inv_inertia = inertia.cwiseInverse();
+  }
+
   int n_nodes() const { return n_elements + 1; }
   int n_voronoi() const { return n_elements - 1; }
   Scalar total_mass() const { return node_masses.sum(); }
@@ -143,6 +155,7 @@ RodModel<Scalar> make_rod_model(const RodParameters<Scalar>& p) {
   }
   m.rest_sigma = RodModel<Scalar>::Array3::Zero(n, 3);
   m.rest_kappa = RodModel<Scalar>::Array3::Zero(n - 1, 3);
+  m.update_reciprocals();
   return m;
 }
 

@@ -20,8 +20,9 @@ template <bool Series, typename Scalar>
 inline void rodrigues_coefficients(Scalar theta_sq, Scalar& sin_over_theta, Scalar& one_minus_cos_over_theta_sq) {
   if constexpr (Series) {
     const Scalar t = theta_sq;
-    sin_over_theta = Scalar(1) - t / 6 * (Scalar(1) - t / 20 * (Scalar(1) - t / 42 * (Scalar(1) - t / 72)));
-    one_minus_cos_over_theta_sq = Scalar(0.5) * (Scalar(1) - t / 12 * (Scalar(1) - t / 30 * (Scalar(1) - t / 56 * (Scalar(1) - t / 90))));
+    // Horner form with reciprocal factorials (multiplications only: divisions do not pipeline).
+    sin_over_theta = Scalar(1) + t * (Scalar(-1.0 / 6) + t * (Scalar(1.0 / 120) + t * (Scalar(-1.0 / 5040) + t * Scalar(1.0 / 362880))));
+    one_minus_cos_over_theta_sq = Scalar(0.5) + t * (Scalar(-1.0 / 24) + t * (Scalar(1.0 / 720) + t * (Scalar(-1.0 / 40320) + t * Scalar(1.0 / 3628800))));
   } else if (theta_sq > 0) {
     const Scalar theta = std::sqrt(theta_sq);
     sin_over_theta = std::sin(theta) / theta;
@@ -40,7 +41,7 @@ template <bool Series, typename Scalar>
 inline Scalar theta_over_sin(Scalar s, Scalar c) {
   const Scalar s2 = s * s;
   if constexpr (Series) {
-    return Scalar(1) + s2 * (Scalar(1) / 6 + s2 * (Scalar(3) / 40 + s2 * (Scalar(5) / 112 + s2 * (Scalar(35) / 1152 + s2 * (Scalar(63) / 2816 + s2 * (Scalar(231) / 13312))))));
+    return Scalar(1) + s2 * (Scalar(1.0 / 6) + s2 * (Scalar(3.0 / 40) + s2 * (Scalar(5.0 / 112) + s2 * (Scalar(35.0 / 1152) + s2 * (Scalar(63.0 / 2816) + s2 * Scalar(231.0 / 13312))))));
   } else {
     if (c > 0 && s2 < small_angle_sq<Scalar>) return theta_over_sin<true>(s, c);
     return s > 0 ? std::atan2(s, c) / s : Scalar(1);
@@ -52,7 +53,7 @@ inline Scalar theta_over_sin(Scalar s, Scalar c) {
 template <bool Series, typename Scalar>
 inline Scalar exp_small(Scalar x) {
   if constexpr (Series) {
-    return Scalar(1) + x * (Scalar(1) + x / 2 * (Scalar(1) + x / 3 * (Scalar(1) + x / 4 * (Scalar(1) + x / 5 * (Scalar(1) + x / 6 * (Scalar(1) + x / 7 * (Scalar(1) + x / 8 * (Scalar(1) + x / 9))))))));
+    return Scalar(1) + x * (Scalar(1) + x * (Scalar(1.0 / 2) + x * (Scalar(1.0 / 6) + x * (Scalar(1.0 / 24) + x * (Scalar(1.0 / 120) + x * (Scalar(1.0 / 720) + x * (Scalar(1.0 / 5040) + x * (Scalar(1.0 / 40320) + x * Scalar(1.0 / 362880)))))))));
   } else {
     return std::exp(x);
   }
