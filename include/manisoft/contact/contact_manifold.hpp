@@ -3,7 +3,8 @@
 // narrow phase (s = s0 + (p_B - p_A) . n, with p_A, p_B the material points that coincided at
 // detection and n attached to the body that owns the contact face: exact for a vertex on a face).
 // Re-detected points are matched to cached ones by proximity, carrying over their accumulated
-// impulses (warm start) and their tangential drift (static friction anchor).
+// normal impulses (warm start); the patch friction state (impulse, static-friction drift) stays
+// with the manifold while its normal keeps its direction.
 #pragma once
 
 #include "manisoft/contact/contact_point.hpp"
@@ -17,19 +18,32 @@ struct ManifoldPoint {
   Vec3 anchor_a{Vec3::Zero()}, anchor_b{Vec3::Zero()};  ///< body-local, relative to each COM
   double base_separation{0};
   // Persistent solver data.
-  double normal_impulse{0};             ///< accumulated, N s
-  Vec3 tangent_impulse{Vec3::Zero()};   ///< accumulated friction impulse, world
-  Vec3 drift{Vec3::Zero()};             ///< tangential slip since the point last stuck (world)
+  double normal_impulse{0};  ///< accumulated, N s
   double max_normal_impulse{0};
   // Per-step solver data.
   Vec3 ra{Vec3::Zero()}, rb{Vec3::Zero()};  ///< contact point relative to each COM, world
   double separation{0}, relax_separation{0};
   double normal_mass{0};
-  Eigen::Matrix2d tangent_mass{Eigen::Matrix2d::Zero()};
-  Eigen::Vector2d friction_impulse{Eigen::Vector2d::Zero()};  ///< in the (t1, t2) basis
-  Eigen::Vector2d drift_2d{Eigen::Vector2d::Zero()};
   double relative_velocity{0};  ///< normal approach speed before the step (restitution)
-  bool sliding{false};
+};
+
+/// Friction acts on the contact patch as a whole, at the centroid of its points: a 2D tangential
+/// impulse bounded by mu * sum(lambda_n) and a twist impulse about the normal bounded by
+/// mu * sum(lambda_n) * twist_radius. Per-point friction anchors would fight each other (each
+/// point's anchor resets at a different time), load the patch internally and make it creep.
+struct PatchFriction {
+  // Persistent.
+  Vec3 tangent_impulse{Vec3::Zero()};  ///< accumulated, world
+  Vec3 drift{Vec3::Zero()};            ///< tangential slip of the centroid since the patch stuck, world
+  double twist_impulse{0}, twist_drift{0};
+  // Per step.
+  Vec3 ra{Vec3::Zero()}, rb{Vec3::Zero()};
+  Eigen::Matrix2d tangent_mass{Eigen::Matrix2d::Zero()};  ///< K_t^-1
+  Eigen::Matrix2d tangent_k{Eigen::Matrix2d::Zero()};     ///< K_t
+  Eigen::Vector2d impulse{Eigen::Vector2d::Zero()};       ///< in the (t1, t2) basis
+  Eigen::Vector2d drift_2d{Eigen::Vector2d::Zero()};
+  double twist_mass{0}, twist_radius{0};
+  bool sliding{false}, twisting{false};
 };
 
 struct ContactManifold {
@@ -40,6 +54,7 @@ struct ContactManifold {
   double friction{0.5}, restitution{0};
   int count{0};
   std::array<ManifoldPoint, kMaxContactPoints> points{};
+  PatchFriction patch{};
   double travel_a{0}, travel_b{0};  ///< body travel when last detected
   bool fresh{true};                 ///< never run through the narrow phase
   // Per step.

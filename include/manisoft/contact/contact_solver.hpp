@@ -18,10 +18,13 @@
 //   d_lambda = -m_eff mass_scale (v_n + bias) - impulse_scale lambda.
 // Normal: bias = s/h when s > 0 (speculative: may close the gap, no more), else
 // max(bias_rate s, -max_push_velocity); lambda >= 0.
-// Friction: 2D tangential impulse, same soft form with bias = bias_rate * drift, where drift is the
-// tangential slip accumulated at the point since it last stuck; the impulse is clamped to the
-// Coulomb disc |lambda_t| <= mu lambda_n. A clamped point is sliding and its drift is reset; a
-// point inside the disc sticks and the anchor spring pulls any creep back: no creep on inclines.
+// Friction (per contact patch, at the centroid of its points, see PatchFriction): 2D tangential
+// impulse, same soft form with bias = bias_rate * drift, where drift is the tangential slip of the
+// centroid accumulated since the patch last stuck; clamped to the Coulomb disc
+// |lambda_t| <= mu sum(lambda_n), in the direction opposing the slip it leaves (maximum
+// dissipation). A clamped patch slides and its drift is reset; a patch inside the disc sticks and
+// the anchor spring pulls any creep back: true static friction, no creep on inclines. Twist about
+// the normal: the same with a scalar impulse bounded by mu sum(lambda_n) r_twist.
 // Relax: the same with bias = 0 (rigid), so the velocity left after the step carries no
 // position-correction term. Restitution: after relax, points that approached faster than the
 // threshold get lambda such that v_n = -e v_n,before.
@@ -68,21 +71,26 @@ struct ContactSolverSettings {
 
 namespace detail {
 
-inline Vec3 relative_velocity(const SolverBody& a, const SolverBody& b, const ManifoldPoint& p) {
-  return b.v + b.w.cross(p.rb) - a.v - a.w.cross(p.ra);
+inline Vec3 relative_velocity(const SolverBody& a, const SolverBody& b, const Vec3& ra, const Vec3& rb) {
+  return b.v + b.w.cross(rb) - a.v - a.w.cross(ra);
 }
 
-inline void apply_impulse(SolverBody& a, SolverBody& b, const ManifoldPoint& p, const Vec3& impulse) {
+inline void apply_impulse(SolverBody& a, SolverBody& b, const Vec3& ra, const Vec3& rb, const Vec3& impulse) {
   a.v -= a.inv_mass * impulse;
-  a.w -= a.inv_inertia * p.ra.cross(impulse);
+  a.w -= a.inv_inertia * ra.cross(impulse);
   b.v += b.inv_mass * impulse;
-  b.w += b.inv_inertia * p.rb.cross(impulse);
+  b.w += b.inv_inertia * rb.cross(impulse);
+}
+
+inline void apply_angular_impulse(SolverBody& a, SolverBody& b, const Vec3& angular) {
+  a.w -= a.inv_inertia * angular;
+  b.w += b.inv_inertia * angular;
 }
 
 }  // namespace detail
 
-/// Prepare: world anchors, current separation, effective masses, restitution speed; warm start
-/// impulses projected on the current tangent basis.
+/// Prepare: world anchors, current separation, effective masses, restitution speed; friction
+/// state projected on the current tangent basis.
 template <typename BodyStates>
 void prepare_contacts(std::vector<ContactManifold>& manifolds, const BodyStates& states,
                       const std::vector<SolverBody>& bodies) {
@@ -95,36 +103,47 @@ void prepare_contacts(std::vector<ContactManifold>& manifolds, const BodyStates&
     m.normal = (m.owner == NormalOwner::shape_a ? sa.rotation : sb.rotation) * m.normal_local;
     tangent_basis(m.normal, m.tangent1, m.tangent2);
     const Vec3& n = m.normal;
+    Vec3 centroid = Vec3::Zero();
     for (int k = 0; k < m.count; ++k) {
       auto& p = m.points[static_cast<std::size_t>(k)];
-      const Vec3 wa = sa.rotation * p.anchor_a;
-      const Vec3 wb = sb.rotation * p.anchor_b;
-      const Vec3 pa = sa.position + wa, pb = sb.position + wb;
+      const Vec3 pa = sa.position + sa.rotation * p.anchor_a;
+      const Vec3 pb = sb.position + sb.rotation * p.anchor_b;
       p.separation = p.base_separation + (pb - pa).dot(n);
       const Vec3 mid = 0.5 * (pa + pb);
+      centroid += mid;
       p.ra = mid - sa.position;
       p.rb = mid - sb.position;
       const Vec3 ran = p.ra.cross(n), rbn = p.rb.cross(n);
       const double kn = ba.inv_mass + bb.inv_mass + ran.dot(ba.inv_inertia * ran) + rbn.dot(bb.inv_inertia * rbn);
       p.normal_mass = kn > 0 ? 1.0 / kn : 0.0;
-      Eigen::Matrix2d kt;
-      const Vec3 t[2] = {m.tangent1, m.tangent2};
-      Vec3 rat[2], rbt[2];
-      for (int i = 0; i < 2; ++i) { rat[i] = p.ra.cross(t[i]); rbt[i] = p.rb.cross(t[i]); }
-      for (int i = 0; i < 2; ++i) {
-        for (int j = 0; j < 2; ++j) {
-          kt(i, j) = (i == j ? ba.inv_mass + bb.inv_mass : 0.0) + rat[i].dot(ba.inv_inertia * rat[j]) +
-                     rbt[i].dot(bb.inv_inertia * rbt[j]);
-        }
-      }
-      const double det = kt.determinant();
-      p.tangent_mass = det > 0 ? Eigen::Matrix2d(kt.inverse()) : Eigen::Matrix2d::Zero();
-      p.relative_velocity = n.dot(detail::relative_velocity(ba, bb, p));
-      p.friction_impulse = {t[0].dot(p.tangent_impulse), t[1].dot(p.tangent_impulse)};
-      p.drift_2d = {t[0].dot(p.drift), t[1].dot(p.drift)};
+      p.relative_velocity = n.dot(detail::relative_velocity(ba, bb, p.ra, p.rb));
       p.max_normal_impulse = 0;
-      p.sliding = false;
     }
+    auto& f = m.patch;
+    centroid /= static_cast<double>(std::max(m.count, 1));
+    f.ra = centroid - sa.position;
+    f.rb = centroid - sb.position;
+    double spread = 0;
+    for (int k = 0; k < m.count; ++k) spread += (m.points[static_cast<std::size_t>(k)].ra - f.ra).norm();
+    // Uniform pressure over a disc through the points: mean lever arm 2/3 of their radius.
+    f.twist_radius = m.count > 1 ? (2.0 / 3.0) * spread / m.count : 0.0;
+    const Vec3 t[2] = {m.tangent1, m.tangent2};
+    Vec3 rat[2], rbt[2];
+    for (int i = 0; i < 2; ++i) { rat[i] = f.ra.cross(t[i]); rbt[i] = f.rb.cross(t[i]); }
+    for (int i = 0; i < 2; ++i) {
+      for (int j = 0; j < 2; ++j) {
+        f.tangent_k(i, j) = (i == j ? ba.inv_mass + bb.inv_mass : 0.0) + rat[i].dot(ba.inv_inertia * rat[j]) +
+                            rbt[i].dot(bb.inv_inertia * rbt[j]);
+      }
+    }
+    const double det = f.tangent_k.determinant();
+    f.tangent_mass = det > 0 ? Eigen::Matrix2d(f.tangent_k.inverse()) : Eigen::Matrix2d::Zero();
+    const double kw = n.dot(ba.inv_inertia * n) + n.dot(bb.inv_inertia * n);
+    f.twist_mass = kw > 0 ? 1.0 / kw : 0.0;
+    f.impulse = {t[0].dot(f.tangent_impulse), t[1].dot(f.tangent_impulse)};
+    f.drift_2d = {t[0].dot(f.drift), t[1].dot(f.drift)};
+    f.sliding = false;
+    f.twisting = false;
   }
 }
 
@@ -134,15 +153,17 @@ inline void warm_start_contacts(std::vector<ContactManifold>& manifolds, std::ve
     auto& ba = bodies[m.body_a];
     auto& bb = bodies[m.body_b];
     for (int k = 0; k < m.count; ++k) {
-      auto& p = m.points[static_cast<std::size_t>(k)];
-      const Vec3 impulse = p.normal_impulse * m.normal + p.friction_impulse[0] * m.tangent1 + p.friction_impulse[1] * m.tangent2;
-      detail::apply_impulse(ba, bb, p, impulse);
+      const auto& p = m.points[static_cast<std::size_t>(k)];
+      detail::apply_impulse(ba, bb, p.ra, p.rb, p.normal_impulse * m.normal);
     }
+    const auto& f = m.patch;
+    detail::apply_impulse(ba, bb, f.ra, f.rb, f.impulse[0] * m.tangent1 + f.impulse[1] * m.tangent2);
+    detail::apply_angular_impulse(ba, bb, f.twist_impulse * m.normal);
   }
 }
 
-/// One Gauss-Seidel pass over all points: friction first (it uses the current normal impulse),
-/// then non-penetration. `use_bias` = soft solve; false = relax (rigid, no position correction).
+/// One Gauss-Seidel pass over all manifolds: patch friction first (it uses the current normal
+/// impulses), then non-penetration point by point. `use_bias` = soft solve; false = relax.
 inline void solve_contacts(std::vector<ContactManifold>& manifolds, std::vector<SolverBody>& bodies,
                            const ContactSolverSettings& s, bool use_bias) {
   const double inv_h = 1.0 / s.h;
@@ -151,70 +172,103 @@ inline void solve_contacts(std::vector<ContactManifold>& manifolds, std::vector<
     auto& ba = bodies[m.body_a];
     auto& bb = bodies[m.body_b];
     const Vec3& n = m.normal;
+    double total_normal = 0;
+    for (int k = 0; k < m.count; ++k) total_normal += m.points[static_cast<std::size_t>(k)].normal_impulse;
+    auto& f = m.patch;
+    const double max_friction = m.friction * total_normal;
+    // Tangential friction at the centroid (Coulomb disc, anchored when sticking).
+    {
+      const Vec3 dv = detail::relative_velocity(ba, bb, f.ra, f.rb);
+      const Eigen::Vector2d vt(m.tangent1.dot(dv), m.tangent2.dot(dv));
+      Eigen::Vector2d d_lambda;
+      if (use_bias) {
+        d_lambda = -s.soft.mass_scale * (f.tangent_mass * (vt + s.soft.bias_rate * f.drift_2d)) - s.soft.impulse_scale * f.impulse;
+      } else {
+        d_lambda = -(f.tangent_mass * vt);
+      }
+      Eigen::Vector2d lambda = f.impulse + d_lambda;
+      const double mag = lambda.norm();
+      const bool clamped = mag > max_friction;
+      if (clamped) {
+        // Sliding: maximum dissipation, the impulse opposes the slip it leaves,
+        // w = v_t + K (lambda - lambda_old); the unconstrained direction K^-1 v_t would not (K is
+        // anisotropic off the centre of mass). Fixed-point iterations on |lambda| = mu lambda_n.
+        lambda *= mag > 0 ? max_friction / mag : 0.0;
+        for (int fp = 0; fp < 3; ++fp) {
+          const Eigen::Vector2d slip = vt + f.tangent_k * (lambda - f.impulse);
+          const double sn = slip.norm();
+          if (!(sn > 1e-12)) break;
+          lambda = -(max_friction / sn) * slip;
+        }
+      }
+      if (use_bias) f.sliding = clamped;
+      d_lambda = lambda - f.impulse;
+      f.impulse = lambda;
+      detail::apply_impulse(ba, bb, f.ra, f.rb, d_lambda[0] * m.tangent1 + d_lambda[1] * m.tangent2);
+    }
+    // Twist friction about the normal.
+    if (f.twist_radius > 0) {
+      const double wn = n.dot(bb.w - ba.w);
+      double d_lambda;
+      if (use_bias) {
+        d_lambda = -s.soft.mass_scale * f.twist_mass * (wn + s.soft.bias_rate * f.twist_drift) - s.soft.impulse_scale * f.twist_impulse;
+      } else {
+        d_lambda = -f.twist_mass * wn;
+      }
+      const double limit = max_friction * f.twist_radius;
+      const double lambda = std::clamp(f.twist_impulse + d_lambda, -limit, limit);
+      if (use_bias) f.twisting = std::abs(f.twist_impulse + d_lambda) > limit;
+      detail::apply_angular_impulse(ba, bb, (lambda - f.twist_impulse) * n);
+      f.twist_impulse = lambda;
+    }
+    // Non-penetration.
     for (int k = 0; k < m.count; ++k) {
       auto& p = m.points[static_cast<std::size_t>(k)];
-      // Friction (Coulomb disc, anchored when sticking).
-      {
-        const Vec3 dv = detail::relative_velocity(ba, bb, p);
-        const Eigen::Vector2d vt(m.tangent1.dot(dv), m.tangent2.dot(dv));
-        Eigen::Vector2d d_lambda;
-        if (use_bias) {
-          const Eigen::Vector2d bias = s.soft.bias_rate * p.drift_2d;
-          d_lambda = -s.soft.mass_scale * (p.tangent_mass * (vt + bias)) - s.soft.impulse_scale * p.friction_impulse;
-        } else {
-          d_lambda = -(p.tangent_mass * vt);
-        }
-        Eigen::Vector2d lambda = p.friction_impulse + d_lambda;
-        const double max_friction = m.friction * p.normal_impulse;
-        const double mag = lambda.norm();
-        if (mag > max_friction) {
-          lambda *= mag > 0 ? max_friction / mag : 0.0;
-          if (use_bias) p.sliding = true;
-        }
-        d_lambda = lambda - p.friction_impulse;
-        p.friction_impulse = lambda;
-        detail::apply_impulse(ba, bb, p, d_lambda[0] * m.tangent1 + d_lambda[1] * m.tangent2);
+      const double vn = n.dot(detail::relative_velocity(ba, bb, p.ra, p.rb));
+      const double sep = use_bias ? p.separation : p.relax_separation;
+      double bias = 0, mass_scale = 1, impulse_scale = 0;
+      if (sep > 0) {
+        bias = sep * inv_h;
+      } else if (use_bias) {
+        bias = std::max(s.soft.bias_rate * sep, -s.max_push_velocity);
+        mass_scale = s.soft.mass_scale;
+        impulse_scale = s.soft.impulse_scale;
       }
-      // Non-penetration.
-      {
-        const double vn = n.dot(detail::relative_velocity(ba, bb, p));
-        const double sep = use_bias ? p.separation : p.relax_separation;
-        double bias = 0, mass_scale = 1, impulse_scale = 0;
-        if (sep > 0) {
-          bias = sep * inv_h;
-        } else if (use_bias) {
-          bias = std::max(s.soft.bias_rate * sep, -s.max_push_velocity);
-          mass_scale = s.soft.mass_scale;
-          impulse_scale = s.soft.impulse_scale;
-        }
-        const double impulse = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
-        const double lambda = std::max(p.normal_impulse + impulse, 0.0);
-        const double applied = lambda - p.normal_impulse;
-        p.normal_impulse = lambda;
-        p.max_normal_impulse = std::max(p.max_normal_impulse, applied);
-        detail::apply_impulse(ba, bb, p, applied * n);
-      }
+      const double impulse = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+      const double lambda = std::max(p.normal_impulse + impulse, 0.0);
+      const double applied = lambda - p.normal_impulse;
+      p.normal_impulse = lambda;
+      p.max_normal_impulse = std::max(p.max_normal_impulse, applied);
+      detail::apply_impulse(ba, bb, p.ra, p.rb, applied * n);
     }
   }
 }
 
 /// Between the solve and the relax pass, after positions moved by h v: the separation the relax
-/// pass sees (s + h v_n) and the tangential slip added to the static-friction drift.
+/// pass sees (s + h v_n) and the slip added to the static-friction drift (reset when sliding).
 inline void update_after_position_integration(std::vector<ContactManifold>& manifolds, std::vector<SolverBody>& bodies,
                                               const ContactSolverSettings& s) {
   for (auto& m : manifolds) {
     if (!m.active) continue;
     const auto& ba = bodies[m.body_a];
     const auto& bb = bodies[m.body_b];
+    double total_normal = 0;
     for (int k = 0; k < m.count; ++k) {
       auto& p = m.points[static_cast<std::size_t>(k)];
-      const Vec3 dv = detail::relative_velocity(ba, bb, p);
-      p.relax_separation = p.separation + s.h * m.normal.dot(dv);
-      if (p.sliding || p.normal_impulse <= 0) {
-        p.drift_2d.setZero();
-      } else {
-        p.drift_2d += s.h * Eigen::Vector2d(m.tangent1.dot(dv), m.tangent2.dot(dv));
-      }
+      p.relax_separation = p.separation + s.h * m.normal.dot(detail::relative_velocity(ba, bb, p.ra, p.rb));
+      total_normal += p.normal_impulse;
+    }
+    auto& f = m.patch;
+    if (f.sliding || total_normal <= 0) {
+      f.drift_2d.setZero();
+    } else {
+      const Vec3 dv = detail::relative_velocity(ba, bb, f.ra, f.rb);
+      f.drift_2d += s.h * Eigen::Vector2d(m.tangent1.dot(dv), m.tangent2.dot(dv));
+    }
+    if (f.twisting || total_normal <= 0) {
+      f.twist_drift = 0;
+    } else {
+      f.twist_drift += s.h * m.normal.dot(bb.w - ba.w);
     }
   }
 }
@@ -228,28 +282,27 @@ inline void apply_restitution(std::vector<ContactManifold>& manifolds, std::vect
     for (int k = 0; k < m.count; ++k) {
       auto& p = m.points[static_cast<std::size_t>(k)];
       if (p.relative_velocity > -s.restitution_threshold || p.max_normal_impulse == 0) continue;
-      const double vn = m.normal.dot(detail::relative_velocity(ba, bb, p));
+      const double vn = m.normal.dot(detail::relative_velocity(ba, bb, p.ra, p.rb));
       const double impulse = -p.normal_mass * (vn + m.restitution * p.relative_velocity);
       const double lambda = std::max(p.normal_impulse + impulse, 0.0);
-      detail::apply_impulse(ba, bb, p, (lambda - p.normal_impulse) * m.normal);
+      detail::apply_impulse(ba, bb, p.ra, p.rb, (lambda - p.normal_impulse) * m.normal);
       p.normal_impulse = lambda;
     }
   }
 }
 
-/// Store: keep the accumulated impulses (world tangent vector) and drift for the next step.
+/// Store: keep the accumulated impulses and drift (world vectors) for the next step.
 inline void store_impulses(std::vector<ContactManifold>& manifolds, const ContactSolverSettings& s) {
   for (auto& m : manifolds) {
     if (!m.active) continue;
-    for (int k = 0; k < m.count; ++k) {
-      auto& p = m.points[static_cast<std::size_t>(k)];
-      if (!s.warm_start) {
-        p.normal_impulse = 0;
-        p.friction_impulse.setZero();
-      }
-      p.tangent_impulse = p.friction_impulse[0] * m.tangent1 + p.friction_impulse[1] * m.tangent2;
-      p.drift = p.drift_2d[0] * m.tangent1 + p.drift_2d[1] * m.tangent2;
+    auto& f = m.patch;
+    if (!s.warm_start) {
+      for (int k = 0; k < m.count; ++k) m.points[static_cast<std::size_t>(k)].normal_impulse = 0;
+      f.impulse.setZero();
+      f.twist_impulse = 0;
     }
+    f.tangent_impulse = f.impulse[0] * m.tangent1 + f.impulse[1] * m.tangent2;
+    f.drift = f.drift_2d[0] * m.tangent1 + f.drift_2d[1] * m.tangent2;
   }
 }
 

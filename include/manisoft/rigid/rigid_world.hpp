@@ -491,6 +491,7 @@ class RigidWorld {
     std::array<bool, contact::kMaxContactPoints> used{};
     const bool same_normal = old_count > 0 && old_normal.dot(c.normal) > 0.95;
     const double match2 = std::pow(std::max(settings_.contact_margin, 1e-3), 2);
+    if (!same_normal) m.patch = {};  // a new contact (or a flipped normal): no friction history
     m.count = c.count;
     m.owner = c.normal_owner;
     m.normal_local = (c.normal_owner == contact::NormalOwner::shape_a ? sa.rotation : sb.rotation).transpose() * c.normal;
@@ -510,10 +511,7 @@ class RigidWorld {
         }
         if (best >= 0) {
           used[static_cast<std::size_t>(best)] = true;
-          const auto& o = old_points[static_cast<std::size_t>(best)];
-          p.normal_impulse = o.normal_impulse;
-          p.tangent_impulse = o.tangent_impulse;
-          p.drift = o.drift;
+          p.normal_impulse = old_points[static_cast<std::size_t>(best)].normal_impulse;
         }
       }
       m.points[static_cast<std::size_t>(k)] = p;
