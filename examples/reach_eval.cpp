@@ -1,0 +1,182 @@
+// reach_eval: success rate of an executor on a seeded set of reach targets (issue 4 part 5).
+//
+//   reach_eval --targets 100 --seed S --set table|equilibria --executor model|mlp
+//              [--weights FILE] [--load-kg M] [--model-error F] [--tol-pos M --tol-rot RAD]
+//              [--damping analytical|analytical:NU|uniform:GAMMA] --out FILE.csv
+//
+// Every target runs the full horizon (1500 control steps). Success: the pose error is within
+// tolerance (|d_p| < tol-pos, |d_r| < tol-rot; defaults 0.03 m, 0.3 rad) and then stays within it
+// for 100 control steps. Prints "success: X% (K of N)", the mean control steps to success (first
+// step of the held window, over successes) and the stability metric (variance of the pose
+// distance d over the last 1000 simulation steps, mean over targets). The CSV has one row per
+// target. --damping picks the simulated rod's damping (default analytical:0.1, PyElastica's).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include "manisoft/control/mlp_executor.hpp"
+#include "manisoft/control/model_executor.hpp"
+#include "manisoft/env/reach_env.hpp"
+
+namespace {
+
+struct Options {
+  int targets = 100;
+  long seed = 0;
+  std::string set = "table", executor = "model", weights, out, damping = "analytical:0.1";
+  double load = 0, model_error = 0, tol_pos = 0.03, tol_rot = 0.3;
+};
+
+[[noreturn]] void usage_error(const std::string& message) {
+  std::cerr << "reach_eval: " << message << "\n"
+            << "usage: reach_eval --targets N --seed S --set table|equilibria --executor model|mlp\n"
+               "                  [--weights FILE] [--load-kg M] [--model-error F] [--tol-pos M --tol-rot RAD]\n"
+               "                  [--damping analytical|analytical:NU|uniform:GAMMA] --out FILE.csv\n";
+  std::exit(2);
+}
+
+double parse_number(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) usage_error(flag + " expects a finite number, got '" + text + "'");
+  return v;
+}
+
+Options parse(int argc, char** argv) {
+  Options o;
+  bool have_out = false, have_seed = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage_error(flag + " needs a value");
+      return argv[++i];
+    };
+    if (flag == "--targets") {
+      const double v = parse_number(flag, value());
+      if (v < 1 || v != std::floor(v) || v > 1e7) usage_error("--targets must be a positive integer");
+      o.targets = static_cast<int>(v);
+    } else if (flag == "--seed") {
+      const double v = parse_number(flag, value());
+      if (v < 0 || v != std::floor(v) || v > 1e15) usage_error("--seed must be a non-negative integer");
+      o.seed = static_cast<long>(v);
+      have_seed = true;
+    } else if (flag == "--set") o.set = value();
+    else if (flag == "--executor") o.executor = value();
+    else if (flag == "--weights") o.weights = value();
+    else if (flag == "--load-kg") o.load = parse_number(flag, value());
+    else if (flag == "--model-error") o.model_error = parse_number(flag, value());
+    else if (flag == "--tol-pos") o.tol_pos = parse_number(flag, value());
+    else if (flag == "--tol-rot") o.tol_rot = parse_number(flag, value());
+    else if (flag == "--damping") o.damping = value();
+    else if (flag == "--out") o.out = value(), have_out = true;
+    else usage_error("unknown option " + flag);
+  }
+  if (!have_out) usage_error("--out FILE.csv is required");
+  if (!have_seed) usage_error("--seed S is required");
+  if (o.set != "table" && o.set != "equilibria") usage_error("--set must be table or equilibria");
+  if (o.executor != "model" && o.executor != "mlp") usage_error("--executor must be model or mlp");
+  if (o.executor == "mlp" && o.weights.empty()) usage_error("--executor mlp needs --weights FILE");
+  if (o.load < 0) usage_error("--load-kg must be >= 0");
+  if (o.tol_pos <= 0 || o.tol_rot <= 0) usage_error("--tol-pos and --tol-rot must be > 0");
+  return o;
+}
+
+template <template <class> class Damping, typename Executor>
+int run(const Options& o, Damping<double> damping, Executor& executor, manisoft::env::ReachEnv<Damping>& env) {
+  (void)damping;
+  std::ofstream csv(o.out);
+  if (!csv) {
+    std::cerr << "reach_eval: cannot write " << o.out << "\n";
+    return 1;
+  }
+  csv << "index,target_x,target_y,target_z,target_rx,target_ry,target_rz,success,first_success_step,final_position_error,"
+         "final_rotation_error,min_distance,stability_variance,diverged,target_draws,setup_us,mean_step_us,clipped_fraction\n";
+  csv.precision(9);
+  int successes = 0;
+  double steps_sum = 0, variance_sum = 0, step_us_sum = 0, setup_us_sum = 0, setup_us_max = 0;
+  long step_count = 0;
+  Eigen::Matrix<double, Eigen::Dynamic, 3> action = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(env.n_elements(), 3);
+  for (int i = 0; i < o.targets; ++i) {
+    const auto* observation = &env.reset(static_cast<std::uint64_t>(o.seed) * 1000003ull + static_cast<std::uint64_t>(i));
+    executor.reset();
+    double min_d = 1e300, setup_us = 0, target_step_us = 0;
+    long clipped = 0;
+    manisoft::env::ReachInfo info;
+    for (int t = 0; t < env.config().horizon; ++t) {
+      const auto t0 = std::chrono::steady_clock::now();
+      executor.act(*observation, action);
+      const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+      if (t == 0) setup_us = us;
+      else target_step_us += us;
+      const auto result = env.step(action);
+      observation = &result.observation;
+      info = result.info;
+      clipped += info.clipped;
+      min_d = std::min(min_d, info.error.distance);
+      if (result.done) break;
+    }
+    const double variance = env.stability_variance();
+    const int steps = std::max(1, info.step - 1);
+    step_us_sum += target_step_us;
+    step_count += steps;
+    setup_us_sum += setup_us;
+    setup_us_max = std::max(setup_us_max, setup_us);
+    variance_sum += variance;
+    if (info.success) {
+      ++successes;
+      steps_sum += info.first_success_step;
+    }
+    const auto& target = env.target();
+    const Eigen::Vector3d rv = manisoft::math::so3::log(target.rotation);
+    csv << i << ',' << target.translation.x() << ',' << target.translation.y() << ',' << target.translation.z() << ',' << rv.x() << ','
+        << rv.y() << ',' << rv.z() << ',' << int(info.success) << ',' << info.first_success_step << ',' << info.error.position_error << ','
+        << info.error.rotation_error << ',' << min_d << ',' << variance << ',' << int(info.diverged) << ',' << env.target_draws() << ','
+        << setup_us << ',' << target_step_us / steps << ',' << double(clipped) / (double(info.step) * 3 * (env.n_elements() - 1)) << '\n';
+  }
+  std::printf("success: %.1f%% (%d of %d)\n", 100.0 * successes / o.targets, successes, o.targets);
+  if (successes > 0) std::printf("mean control steps to success: %.1f\n", steps_sum / successes);
+  else std::printf("mean control steps to success: n/a (no success)\n");
+  std::printf("stability (variance of d over the last 1000 simulation steps, mean over targets): %.3e\n", variance_sum / o.targets);
+  std::printf("executor compute: %.2f us per control step (mean), set-up %.0f us per target (mean, max %.0f)\n",
+              step_us_sum / double(std::max(1L, step_count)), setup_us_sum / o.targets, setup_us_max);
+  return 0;
+}
+
+template <template <class> class Damping>
+int run_with(const Options& o, Damping<double> damping) {
+  manisoft::env::ReachEnvConfig config;
+  config.target_set = manisoft::env::parse_target_set(o.set);
+  config.load_mass = o.load;
+  config.model_error = o.model_error;
+  config.tolerance_position = o.tol_pos;
+  config.tolerance_rotation = o.tol_rot;
+  manisoft::env::ReachEnv<Damping> env(config, damping);
+  if (o.executor == "model") {
+    manisoft::control::ModelExecutor<double> executor(env.nominal_model(), config.limits);
+    return run(o, damping, executor, env);
+  }
+  manisoft::control::MlpExecutor<double> executor(manisoft::control::Mlp<double>::load(o.weights), env.n_elements(), config.limits);
+  return run(o, damping, executor, env);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options o = parse(argc, argv);
+  try {
+    const std::string d = o.damping;
+    const auto colon = d.find(':');
+    const std::string kind = d.substr(0, colon);
+    const double value = colon == std::string::npos ? -1 : parse_number("--damping", d.substr(colon + 1));
+    if (kind == "analytical") return run_with<manisoft::damping::AnalyticalLinear>(o, manisoft::damping::AnalyticalLinear<double>(value < 0 ? 0.1 : value));
+    if (kind == "uniform") return run_with<manisoft::damping::UniformExp>(o, manisoft::damping::UniformExp<double>(value < 0 ? 1.0 : value));
+    usage_error("--damping must be analytical[:NU] or uniform[:GAMMA]");
+  } catch (const manisoft::Error& e) {
+    std::cerr << "reach_eval: " << e.what() << "\n";
+    return 1;
+  }
+}

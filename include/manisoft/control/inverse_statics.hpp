@@ -1,0 +1,482 @@
+// Inverse statics of a clamped Cosserat rod arm (issue 4 part 3; DESIGN.md section 8): finds a
+// static shape whose tip frame (last node, last element's directors) is a target SE(3) pose, and
+// the material-frame element torques that make that shape an exact equilibrium of the discrete
+// rod of rod/internal_forces.hpp.
+//
+// Shape family. The curvature/twist at Voronoi point k (arc length s_k, sigma = s_k / L) is a
+// quadratic per material axis, kappa_i(s) = c_{3i} + c_{3i+1} sigma + c_{3i+2} sigma^2 (9
+// coefficients, 1/m). Directors follow the rod's own discrete operator
+//   Q_{k+1} = exp(-[kappa_k l0v_k]x) Q_k          (so that kappa_k = -log(Q_{k+1} Q_k^T) / l0v_k),
+// from the clamped Q_0. Positions carry the shear/stretch that statics requires: the lab-frame
+// internal force of element k is the sum of the external loads beyond it (gravity m_j g on every
+// node j > k plus the payload m_p g on the tip node), n_k = S (e_k Q_k t_k - e3) with
+// n_k = e_k Q_k (that force), solved for u_k = e_k Q_k t_k by fixed-point iteration, and
+// x_{k+1} = x_k + l0_k Q_k^T u_k. Gravity and the payload then enter the torque balance through
+// the shear couple (Q t x n) l0 exactly as in the simulated rod (DESIGN.md section 8).
+//
+// Feed-forward. tau_ff = -(internal torque of the rod at the desired state, zero velocities):
+// every element except the clamped one is in exact torque balance and every free node in exact
+// force balance, so the desired state is an equilibrium to round-off. The clamped element 0
+// carries no actuator (its rates are zeroed by the boundary condition): its entry is set to 0.
+//
+// Solver. Levenberg-Marquardt on the 6 tip-pose residuals
+//   r = [p(c) - p*;  w_rot log(R*^T R(c))]
+// plus a small regularizer mu c^T W c, where c^T W c is a curvature norm weighted like the
+// elastic actuation effort: sum over actuated elements of |B (kappa_k - kappa_{k-1})|^2 / tau_ref^2
+// (a Sobolev norm of kappa; it prefers shapes the torque limits can hold) plus eps int |kappa|^2.
+// A few minimum-W-norm Gauss-Newton steps with mu = 0 then remove the regularizer's bias, so the
+// returned shape meets the target to ~1e-12 m. The Jacobian is by forward differences. Warm start:
+// solve() starts from the previous solution; cold targets try a small set of start shapes.
+// No heap allocation after construction.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "manisoft/core/error.hpp"
+#include "manisoft/math/se3.hpp"
+#include "manisoft/math/so3.hpp"
+#include "manisoft/rod/internal_forces.hpp"
+
+namespace manisoft::control {
+
+/// What the inverse statics (and the model executor) assume about the arm: a uniform clamped
+/// rod (its RodModel), the clamp pose, uniform gravity and a point payload on the tip node.
+template <typename Scalar>
+struct ArmModel {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+  RodModel<Scalar> rod;
+  Vector3 base_position = Vector3::Zero();
+  Matrix3 base_directors = Matrix3::Identity();  ///< Q_0, rows d1, d2, d3 (lab)
+  Vector3 gravity{0, 0, Scalar(-9.81)};           ///< m/s^2
+  Scalar payload_mass = Scalar(0.2);              ///< kg, point mass on the tip node (gripper)
+};
+
+/// The arm model of a straight rod built from `params` (its base pose is the clamp).
+template <typename Scalar>
+ArmModel<Scalar> make_arm_model(const RodParameters<Scalar>& params, Scalar payload_mass = Scalar(0.2),
+                                const Eigen::Matrix<Scalar, 3, 1>& gravity = {0, 0, Scalar(-9.81)}) {
+  detail::require_non_negative("payload_mass", payload_mass);
+  if (!gravity.allFinite()) detail::fail("gravity = (", gravity.transpose(), ") is invalid: it must be finite");
+  ArmModel<Scalar> m;
+  m.rod = make_rod_model(params);
+  const RodState<Scalar> s = make_straight_rod_state(params);
+  m.base_position = s.position(0);
+  m.base_directors = s.director(0);
+  m.gravity = gravity;
+  m.payload_mass = payload_mass;
+  return m;
+}
+
+/// Per-element actuation limits of the material-frame torques (N m): |tau_1|, |tau_2| <= bend,
+/// |tau_3| <= twist on every actuated element (all but the clamped element 0).
+template <typename Scalar>
+struct ActuationLimits {
+  Scalar bend = Scalar(40);
+  Scalar twist = Scalar(20);
+  Scalar limit(int component) const { return component < 2 ? bend : twist; }
+};
+
+template <typename Scalar>
+struct InverseStaticsSettings {
+  Scalar rotation_weight = Scalar(0.5);       ///< w_rot, m/rad in the residual
+  Scalar regularization = Scalar(1e-7);       ///< mu (dimensionless, on the effort norm)
+  Scalar reference_torque = Scalar(10);       ///< tau_ref of the effort norm, N m
+  Scalar curvature_weight = Scalar(1e-2);     ///< eps of int |kappa|^2 ds (relative)
+  int max_iterations = 60;                    ///< LM iterations per start
+  int polish_iterations = 12;                 ///< effort-minimizing SQP steps after LM
+  Scalar tolerance = Scalar(1e-11);           ///< |r| at which a solve stops, m
+  Scalar accept_error = Scalar(1e-6);         ///< |r| below which a solve counts as converged
+};
+
+template <typename Scalar>
+struct InverseStaticsResult {
+  bool converged = false;          ///< tip pose met to accept_error
+  Scalar position_error = 0;       ///< |p(c) - p*|, m
+  Scalar rotation_error = 0;       ///< |log(R*^T R(c))|, rad
+  int iterations = 0;              ///< LM + polish iterations used
+  Scalar max_torque_ratio = 0;     ///< max over elements/components of |tau_ff| / limit
+  bool within_limits = false;      ///< converged and max_torque_ratio <= 1
+};
+
+template <typename Scalar>
+class InverseStatics {
+ public:
+  static constexpr int n_coefficients = 9;
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+  using Coefficients = Eigen::Matrix<Scalar, n_coefficients, 1>;
+  using Residual = Eigen::Matrix<Scalar, 6, 1>;
+  using Jacobian = Eigen::Matrix<Scalar, 6, n_coefficients>;
+  using Matrix9 = Eigen::Matrix<Scalar, n_coefficients, n_coefficients>;
+  using Array3 = Eigen::Matrix<Scalar, Eigen::Dynamic, 3>;
+  using Pose = math::Pose<Scalar>;
+
+  explicit InverseStatics(ArmModel<Scalar> model, InverseStaticsSettings<Scalar> settings = {},
+                          ActuationLimits<Scalar> limits = {})
+      : model_(std::move(model)), settings_(settings), limits_(limits), workspace_(model_.rod.n_elements) {
+    const int n = model_.rod.n_elements;
+    if (n < 3) detail::fail("InverseStatics needs a rod of at least 3 elements, got ", n);
+    detail::require_positive("InverseStatics rotation_weight", settings_.rotation_weight);
+    detail::require_non_negative("InverseStatics regularization", settings_.regularization);
+    detail::require_positive("InverseStatics reference_torque", settings_.reference_torque);
+    detail::require_non_negative("InverseStatics curvature_weight", settings_.curvature_weight);
+    detail::require_positive("ActuationLimits bend", limits_.bend);
+    detail::require_positive("ActuationLimits twist", limits_.twist);
+    if (!model_.base_position.allFinite() || !model_.base_directors.allFinite())
+      detail::fail("InverseStatics: the base pose is not finite");
+    const Matrix3 should_be_identity = model_.base_directors * model_.base_directors.transpose();
+    if ((should_be_identity - Matrix3::Identity()).norm() > Scalar(1e-6))
+      detail::fail("InverseStatics: base_directors is not a rotation (|Q Q^T - I| = ",
+                   (should_be_identity - Matrix3::Identity()).norm(), ")");
+    sigma_.resize(n - 1);
+    Scalar s = 0;
+    for (int k = 0; k < n - 1; ++k) {
+      s += model_.rod.rest_lengths[k];
+      sigma_[k] = s / model_.rod.total_length();
+    }
+    // Lab-frame internal force of each element: the sum of external loads on the nodes beyond it.
+    distal_force_.resize(n, 3);
+    Vector3 acc = model_.gravity * model_.payload_mass;
+    for (int k = n - 1; k >= 0; --k) {
+      acc += model_.gravity * model_.rod.node_masses[k + 1];
+      distal_force_.row(k) = acc.transpose();
+    }
+    build_regularizer();
+    state_.positions.setZero(n + 1, 3);
+    state_.velocities.setZero(n + 1, 3);
+    state_.directors.setZero(n, 9);
+    state_.angular_velocities.setZero(n, 3);
+    state_.external_forces.setZero(n + 1, 3);
+    state_.external_torques.setZero(n, 3);
+    directors_.resize(n);
+    positions_cache_.assign(n + 1, model_.base_position);
+    feedforward_.setZero(n, 3);
+    coefficients_.setZero();
+    shape(coefficients_);
+    commit();
+  }
+
+  const ArmModel<Scalar>& model() const { return model_; }
+  const ActuationLimits<Scalar>& limits() const { return limits_; }
+  const InverseStaticsSettings<Scalar>& settings() const { return settings_; }
+  int n_elements() const { return model_.rod.n_elements; }
+
+  /// Forward statics: the tip pose of the shape with curvature coefficients c (fills the
+  /// internal shape buffers; does not change the committed solution).
+  Pose tip_pose(const Coefficients& c) {
+    shape(c);
+    return Pose{directors_[n_elements() - 1].transpose(), tip_};
+  }
+
+  /// Solves for `target` starting from the last solution (warm start). Does not allocate.
+  InverseStaticsResult<Scalar> solve(const Pose& target) { return solve_from(target, coefficients_); }
+
+  /// Solves for a new, unrelated target: tries the straight shape, the last solution and a few
+  /// bent start shapes, stops at the first converged solution within the actuation limits, else
+  /// keeps the converged one with the smallest actuation (or the smallest residual if none
+  /// converged). Does not allocate.
+  InverseStaticsResult<Scalar> solve_cold(const Pose& target) {
+    require_finite_target(target);
+    const Coefficients previous = coefficients_;
+    std::array<Coefficients, 6> starts;
+    starts[0].setZero();
+    starts[1] = previous;
+    // Start shapes that bend about d2 (towards -d1 or +d1) and sideways about d1, with a
+    // decaying profile (cheap to hold).
+    for (int i = 2; i < 6; ++i) {
+      starts[i].setZero();
+      const Scalar amp = (i == 2 || i == 3) ? Scalar(3) : Scalar(2.5);
+      const int axis = (i < 4) ? 1 : 0;
+      const Scalar sign = (i % 2 == 0) ? Scalar(1) : Scalar(-1);
+      starts[i][3 * axis] = sign * amp;
+      starts[i][3 * axis + 1] = -sign * amp;
+    }
+    InverseStaticsResult<Scalar> best;
+    Coefficients best_c = previous;
+    Scalar best_score = std::numeric_limits<Scalar>::infinity();
+    for (const Coefficients& start : starts) {
+      const InverseStaticsResult<Scalar> r = solve_from(target, start);
+      const Scalar residual = r.position_error + settings_.rotation_weight * r.rotation_error;
+      // Converged solutions rank by actuation, the others after them by residual.
+      const Scalar score = r.converged ? r.max_torque_ratio : Scalar(1e6) + residual;
+      if (score < best_score) {
+        best_score = score;
+        best = r;
+        best_c = coefficients_;
+      }
+      if (r.within_limits) break;
+    }
+    shape(best_c);
+    coefficients_ = best_c;
+    commit();
+    return best;
+  }
+
+  /// Solves from an explicit start; the result becomes the committed solution.
+  InverseStaticsResult<Scalar> solve_from(const Pose& target, const Coefficients& start) {
+    require_finite_target(target);
+    if (!start.allFinite()) detail::fail("InverseStatics: the start coefficients are not finite");
+    Coefficients c = start;
+    Residual r = residual(c, target);
+    Scalar cost = objective(r, c, settings_.regularization);
+    Scalar lambda = Scalar(1e-3);
+    int it = 0;
+    for (; it < settings_.max_iterations && r.norm() > settings_.tolerance; ++it) {
+      jacobian(c, r, target);
+      const Scalar mu = settings_.regularization;
+      const Matrix9 a = jacobian_.transpose() * jacobian_ + mu * regularizer_;
+      const Coefficients g = jacobian_.transpose() * r + mu * regularizer_ * c;
+      bool improved = false, stalled = false;
+      for (int tries = 0; tries < 8; ++tries) {
+        Matrix9 damped = a;
+        damped.diagonal() += lambda * (a.diagonal().array() + Scalar(1e-9)).matrix();
+        const Coefficients step = -damped.ldlt().solve(g);
+        const Coefficients trial = c + step;
+        const Residual r_trial = residual(trial, target);
+        const Scalar cost_trial = objective(r_trial, trial, mu);
+        if (std::isfinite(cost_trial) && cost_trial < cost) {
+          const Scalar decrease = cost - cost_trial;
+          c = trial;
+          r = r_trial;
+          cost = cost_trial;
+          // Converged to the regularized optimum: the polish below removes its small bias.
+          if (step.norm() < Scalar(1e-7) || decrease < Scalar(1e-6) * cost) stalled = true;
+          lambda = std::max(lambda * Scalar(0.3), Scalar(1e-9));
+          improved = true;
+          break;
+        }
+        lambda *= Scalar(10);
+      }
+      if (!improved || stalled) break;
+    }
+    // Polish: Gauss-Newton steps on the constraint r = 0 that also minimize the effort norm of
+    // the new point (SQP on  min c^T W c  s.t. r(c) = 0):
+    //   c+ = argmin |c + d|_W  s.t.  J d = -r   =>   c+ = W^-1 J^T (J W^-1 J^T)^-1 (J c - r).
+    // This removes mu's bias and slides along the 3-dimensional solution manifold to the least
+    // effortful shape near the LM solution. A step is kept while the residual stays small.
+    const Scalar residual_cap = std::max(Scalar(10) * r.norm(), Scalar(1e-4));
+    for (int p = 0; p < settings_.polish_iterations; ++p, ++it) {
+      jacobian(c, r, target);
+      const Eigen::Matrix<Scalar, n_coefficients, 6> wj = regularizer_inverse_ * jacobian_.transpose();
+      const Eigen::Matrix<Scalar, 6, 6> m = jacobian_ * wj;
+      const Coefficients proposal = wj * m.ldlt().solve(jacobian_ * c - r);
+      Coefficients trial = proposal;
+      Residual r_trial = residual(trial, target);
+      for (int half = 0; half < 6 && !(r_trial.norm() < residual_cap); ++half) {
+        trial = Scalar(0.5) * (trial + c);
+        r_trial = residual(trial, target);
+      }
+      if (!(r_trial.norm() < residual_cap)) break;
+      const Scalar effort_change = trial.dot(regularizer_ * trial) - c.dot(regularizer_ * c);
+      const bool done = r_trial.norm() < settings_.tolerance && std::abs(effort_change) < Scalar(1e-9) * (Scalar(1) + c.dot(regularizer_ * c));
+      c = trial;
+      r = r_trial;
+      if (done) break;
+    }
+    // Final Newton steps (minimum-W-norm step) so the shape meets the target to round-off.
+    for (int p = 0; p < 3 && r.norm() > settings_.tolerance; ++p, ++it) {
+      jacobian(c, r, target);
+      const Eigen::Matrix<Scalar, n_coefficients, 6> wj = regularizer_inverse_ * jacobian_.transpose();
+      const Eigen::Matrix<Scalar, 6, 6> m = jacobian_ * wj;
+      const Coefficients trial = c - wj * m.ldlt().solve(r);
+      const Residual r_trial = residual(trial, target);
+      if (!(r_trial.norm() < r.norm())) break;
+      c = trial;
+      r = r_trial;
+    }
+    shape(c);
+    coefficients_ = c;
+    commit();
+    InverseStaticsResult<Scalar> result;
+    result.position_error = r.template head<3>().norm();
+    result.rotation_error = r.template tail<3>().norm() / settings_.rotation_weight;
+    result.iterations = it;
+    result.converged = std::isfinite(r.norm()) && r.norm() < settings_.accept_error;
+    result.max_torque_ratio = max_torque_ratio();
+    result.within_limits = result.converged && result.max_torque_ratio <= Scalar(1);
+    return result;
+  }
+
+  /// Makes c the committed solution (shape and feed-forward) without solving.
+  void set_coefficients(const Coefficients& c) {
+    if (!c.allFinite()) detail::fail("InverseStatics: coefficients are not finite");
+    shape(c);
+    coefficients_ = c;
+    commit();
+  }
+
+  // ---- the committed solution
+  const Coefficients& coefficients() const { return coefficients_; }
+  /// The desired static state (positions, directors; zero rates).
+  const RodState<Scalar>& desired_state() const { return state_; }
+  /// Feed-forward material-frame element torques, n x 3 (row 0, the clamped element, is 0).
+  const Array3& feedforward() const { return feedforward_; }
+  /// The desired shape's tip pose (body to lab).
+  Pose desired_tip_pose() const {
+    return Pose{state_.director(n_elements() - 1).transpose(), state_.tip_position()};
+  }
+  /// Curvature at Voronoi point k of coefficients c (material frame, 1/m).
+  Vector3 curvature(const Coefficients& c, int k) const {
+    const Scalar s = sigma_[k];
+    return Vector3(c[0] + s * (c[1] + s * c[2]), c[3] + s * (c[4] + s * c[5]), c[6] + s * (c[7] + s * c[8]));
+  }
+
+ private:
+  static void require_finite_target(const Pose& target) {
+    if (!target.is_finite()) detail::fail("InverseStatics: the target pose is not finite (translation = ", target.translation.transpose(), ")");
+    const Matrix3 e = target.rotation * target.rotation.transpose() - Matrix3::Identity();
+    if (e.norm() > Scalar(1e-6) || target.rotation.determinant() < 0)
+      detail::fail("InverseStatics: the target rotation is not a rotation matrix (|R R^T - I| = ", e.norm(), ")");
+  }
+
+  Scalar objective(const Residual& r, const Coefficients& c, Scalar mu) const {
+    return r.squaredNorm() + mu * c.dot(regularizer_ * c);
+  }
+
+  Residual residual(const Coefficients& c, const Pose& target) {
+    shape(c);
+    Residual r;
+    r.template head<3>() = tip_ - target.translation;
+    const Matrix3 tip_rotation = directors_[n_elements() - 1].transpose();
+    r.template tail<3>() = settings_.rotation_weight * math::so3::log(target.rotation.transpose() * tip_rotation);
+    return r;
+  }
+
+  /// Analytic Jacobian of the residual at c. Perturbing kappa_k by d rotates everything beyond
+  /// Voronoi point k by the lab-frame angle omega = G_k d, G_k = l0v_k Q_k^T J_r(-kappa_k l0v_k)
+  /// (right-perturbation Jacobian of SO(3), [Sola (143)]), about node k + 1:
+  ///   d p_tip = omega x (p_tip - x_{k+1}),   d log(R*^T R) = J_r^-1(log(R*^T R)) R^T omega.
+  /// The change of the small shear offsets with orientation (S^-1 ~ 1e-3 relative) is neglected:
+  /// Gauss-Newton then still converges, linearly at a rate ~1e-3.
+  void jacobian(const Coefficients& c, const Residual& r, const Pose& target) {
+    (void)r;
+    shape(c);
+    const int n = n_elements();
+    const Matrix3 tip_rotation = directors_[n - 1].transpose();
+    Matrix3 jr_inv;
+    math::so3::log(target.rotation.transpose() * tip_rotation, &jr_inv);
+    const Matrix3 rot_map = settings_.rotation_weight * jr_inv * tip_rotation.transpose();
+    jacobian_.setZero();
+    for (int k = 0; k < n - 1; ++k) {
+      const Scalar l0v = model_.rod.rest_voronoi_lengths[k];
+      const Vector3 phi = -curvature(c, k) * l0v;
+      const Matrix3 g = l0v * directors_[k].transpose() * math::so3::right_jacobian(phi);
+      const Vector3 arm = tip_ - positions_cache_[k + 1];
+      Eigen::Matrix<Scalar, 6, 3> block;
+      block.template topRows<3>() = -math::so3::hat(arm) * g;
+      block.template bottomRows<3>() = rot_map * g;
+      const Scalar s = sigma_[k];
+      for (int axis = 0; axis < 3; ++axis) {
+        jacobian_.col(3 * axis) += block.col(axis);
+        jacobian_.col(3 * axis + 1) += s * block.col(axis);
+        jacobian_.col(3 * axis + 2) += s * s * block.col(axis);
+      }
+    }
+  }
+
+  /// Forward statics of coefficients c into directors_ and the shape's node positions (state_
+  /// positions are only written by commit()).
+  void shape(const Coefficients& c) {
+    const int n = n_elements();
+    const auto& rod = model_.rod;
+    directors_[0] = model_.base_directors;
+    for (int k = 0; k < n - 1; ++k) {
+      const Vector3 phi = -curvature(c, k) * rod.rest_voronoi_lengths[k];
+      directors_[k + 1] = math::so3::exp(phi) * directors_[k];
+    }
+    Vector3 x = model_.base_position;
+    for (int k = 0; k < n; ++k) {
+      const Matrix3& q = directors_[k];
+      const Vector3 force_material = q * distal_force_.row(k).transpose();
+      const Vector3 compliance(Scalar(1) / rod.shear_stiffness(k, 0), Scalar(1) / rod.shear_stiffness(k, 1),
+                               Scalar(1) / rod.shear_stiffness(k, 2));
+      // u = sigma0 + e3 + |u| S^-1 Q f  (fixed point; S^-1 Q f ~ 1e-3, converges to round-off in ~6 sweeps)
+      const Vector3 base = rod.rest_sigma.row(k).transpose() + Vector3::UnitZ();
+      const Vector3 load = compliance.cwiseProduct(force_material);
+      Vector3 u = base + load;
+      for (int i = 0; i < 8; ++i) {
+        const Vector3 next = base + u.norm() * load;
+        const Scalar change = (next - u).squaredNorm();
+        u = next;
+        if (change < Scalar(1e-30)) break;
+      }
+      x += rod.rest_lengths[k] * (q.transpose() * u);
+      positions_cache_[k + 1] = x;
+    }
+    tip_ = x;
+  }
+
+  /// Copies the current shape buffers into the desired state and recomputes the feed-forward.
+  void commit() {
+    const int n = n_elements();
+    state_.positions.row(0) = model_.base_position.transpose();
+    for (int k = 1; k <= n; ++k) state_.positions.row(k) = positions_cache_[k].transpose();
+    for (int k = 0; k < n; ++k) state_.set_director(k, directors_[k]);
+    compute_internal_forces_and_torques(model_.rod, state_, workspace_);
+    feedforward_ = -workspace_.internal_torques;
+    feedforward_.row(0).setZero();
+  }
+
+  Scalar max_torque_ratio() const {
+    Scalar worst = 0;
+    for (int k = 1; k < n_elements(); ++k)
+      for (int i = 0; i < 3; ++i) worst = std::max(worst, std::abs(feedforward_(k, i)) / limits_.limit(i));
+    return worst;
+  }
+
+  /// W = T^T T / tau_ref^2 + eps int kappa^2: T maps c to the elastic part of the element torques
+  /// B (kappa_k - kappa_{k-1}) of elements 1 .. n-1 (kappa_{n-1} = 0 past the tip).
+  void build_regularizer() {
+    const int n = n_elements();
+    const auto& rod = model_.rod;
+    regularizer_.setZero();
+    const Scalar inv_ref2 = Scalar(1) / (settings_.reference_torque * settings_.reference_torque);
+    for (int axis = 0; axis < 3; ++axis) {
+      Eigen::Matrix<Scalar, 3, 3> block = Eigen::Matrix<Scalar, 3, 3>::Zero();
+      for (int k = 1; k < n; ++k) {
+        Eigen::Matrix<Scalar, 3, 1> row = Eigen::Matrix<Scalar, 3, 1>::Zero();
+        auto basis = [&](int v) { return Eigen::Matrix<Scalar, 3, 1>(1, sigma_[v], sigma_[v] * sigma_[v]); };
+        const Scalar b_here = k < n - 1 ? rod.bend_stiffness(k, axis) : Scalar(0);
+        const Scalar b_prev = rod.bend_stiffness(k - 1, axis);
+        if (k < n - 1) row += b_here * basis(k);
+        row -= b_prev * basis(k - 1);
+        block += row * row.transpose() * inv_ref2;
+      }
+      // int kappa^2 ds scaled to the same units: eps * (B / tau_ref)^2 * (Voronoi sum)
+      Eigen::Matrix<Scalar, 3, 3> mass = Eigen::Matrix<Scalar, 3, 3>::Zero();
+      for (int k = 0; k < n - 1; ++k) {
+        const Eigen::Matrix<Scalar, 3, 1> b(1, sigma_[k], sigma_[k] * sigma_[k]);
+        const Scalar scale = rod.bend_stiffness(k, axis) * rod.bend_stiffness(k, axis) * inv_ref2 * rod.rest_voronoi_lengths[k];
+        mass += scale * b * b.transpose();
+      }
+      regularizer_.template block<3, 3>(3 * axis, 3 * axis) = block + settings_.curvature_weight * mass;
+    }
+    regularizer_inverse_ = regularizer_.ldlt().solve(Matrix9::Identity());
+  }
+
+  ArmModel<Scalar> model_;
+  InverseStaticsSettings<Scalar> settings_;
+  ActuationLimits<Scalar> limits_;
+  RodWorkspace<Scalar> workspace_;
+  RodState<Scalar> state_;
+  Eigen::Matrix<Scalar, Eigen::Dynamic, 1> sigma_;
+  Array3 distal_force_;
+  std::vector<Matrix3> directors_;
+  std::vector<Vector3> positions_cache_;
+  Vector3 tip_ = Vector3::Zero();
+  Array3 feedforward_;
+  Coefficients coefficients_;
+  Jacobian jacobian_;
+  Matrix9 regularizer_;
+  Matrix9 regularizer_inverse_;
+};
+
+}  // namespace manisoft::control

@@ -1,0 +1,324 @@
+// ReachEnv: the executor benchmark environment of issue 4 (paper section 3.4 and appendix):
+// reach a target end-effector SE(3) pose with the soft arm and hold it.
+//
+//   env.reset(seed) -> observation;  env.step(action) -> {observation, reward, done, info}
+//
+// Arm (paper "Key Parameters", DESIGN.md 3): n = 20, L = 1 m, r = 0.05 m, rho = 1000, E = 1e7,
+// G = E/3, base clamped at the origin with d3 = +x (horizontal), d1 = +z, gravity -z,
+// dt = 2e-4 s, PositionVerlet, 7 substeps per control step (714 Hz), horizon 1500 control steps.
+// End-effector: the tip frame (last node, last element's directors) carrying the gripper
+// (0.2 kg) plus an optional held load, modelled as a tip force m g (forcing::TipLoad).
+// `model_error` F makes the simulated Young's modulus (1 + F) times the nominal one; the
+// nominal model (nominal_model()) is what an executor should assume: nominal E, gripper only.
+// Action: n x 3 material-frame element torques, clamped to the actuation limits
+// (ActuationLimits: |tau_1|, |tau_2| <= 150 N m, |tau_3| <= 75 N m; element 0 is clamped and
+// takes no torque). The limits are set by what the inverse statics needs: a shape with tip
+// curvature kappa(L) must be held by the tip element's couple B kappa(L) (B = EI = 49 N m^2).
+// Observation: target, end-effector pose, positions and velocities of every
+// `observe_stride`-th node (always including the tip).
+// Reward: R = R_d + R_s of the paper (d = |d_p| + 0.2 |d_r|; R_d with k1 = 0.5, k2 = 1.5,
+// d1 = 0.1, d2 = 0.05; R_s with beta = 1, D = 0.3). info reports the pose error, whether it is
+// within tolerance, and the success of the episode: within tolerance, then held for
+// `hold_steps` control steps (first_success_step is the first step of that held window).
+//
+// Target sets (seeded; every target is reachable at equilibrium by the nominal model within
+// the actuation limits, checked with the inverse statics, else redrawn):
+//   table       the gripper above a table top, pointing down: position uniform in
+//               x in [0.40, 0.85], y in [-0.25, 0.25], z in [-0.70, -0.30] m (table plane
+//               z = -0.75 m, the arm's base 0.75 m above it), tool axis d3 within 45 deg of -z
+//               (uniform on the cap), any yaw. Measured with the quadratic-curvature inverse
+//               statics: about 56% of such poses are reachable within the limits (x < 0.4 or
+//               x > 0.85 needs more tip torque; yaw does not matter much), the rest are redrawn.
+//   equilibria  tip poses where the arm settles under random bounded actuation: per axis a
+//               random quadratic torque profile along the arm (|tau| <= 10 N m bend,
+//               4 N m twist) plus a random tip-element couple (<= 60 N m bend, 20 N m twist),
+//               settled with heavy uniform damping; actuations that do not settle within 4 s
+//               (follower-torque flutter) or whose pose the inverse statics cannot hold within
+//               the limits are redrawn.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <string>
+
+#include "manisoft/control/executor.hpp"
+#include "manisoft/control/inverse_statics.hpp"
+#include "manisoft/core/error.hpp"
+#include "manisoft/reward/distance_reward.hpp"
+#include "manisoft/reward/pose_distance.hpp"
+#include "manisoft/reward/stability_reward.hpp"
+#include "manisoft/reward/sum.hpp"
+#include "manisoft/rod/cosserat_rod.hpp"
+
+namespace manisoft::env {
+
+enum class TargetSet { table, equilibria };
+
+inline TargetSet parse_target_set(const std::string& name) {
+  if (name == "table") return TargetSet::table;
+  if (name == "equilibria") return TargetSet::equilibria;
+  detail::fail("unknown target set '", name, "': expected table or equilibria");
+}
+
+struct ReachEnvConfig {
+  RodParameters<double> rod{};              ///< nominal arm (defaults: the paper's)
+  double dt = 2e-4;                         ///< s
+  int substeps = 7;                         ///< simulation steps per control step (714 Hz)
+  int horizon = 1500;                       ///< control steps per episode
+  double gripper_mass = 0.2;                ///< kg, known to the executor's model
+  double load_mass = 0;                     ///< kg, held load unknown to the model
+  double model_error = 0;                   ///< F: simulated E = (1 + F) E_nominal
+  int observe_stride = 2;                   ///< observe every k-th node (and the tip)
+  TargetSet target_set = TargetSet::table;
+  control::ActuationLimits<double> limits{150, 75};
+  double tolerance_position = 0.03;         ///< m, on |d_p|
+  double tolerance_rotation = 0.3;          ///< rad, on |d_r|
+  int hold_steps = 100;                     ///< control steps the tolerance must hold
+  int stability_window = 1000;              ///< simulation steps of the stability variance
+};
+
+struct ReachInfo {
+  reward::PoseError<double> error{};
+  bool in_tolerance = false;
+  bool success = false;            ///< held within tolerance for hold_steps
+  int first_success_step = -1;     ///< first control step of the held window, -1 if none
+  int step = 0;                    ///< control steps taken
+  bool diverged = false;           ///< the simulated rod refused a step (state kept)
+  int clipped = 0;                 ///< action entries clipped to the limits in this step
+};
+
+template <template <class> class Damping = damping::AnalyticalLinear>
+class ReachEnv {
+ public:
+  using Rod = CosseratRod<double, Damping, bc::ClampedBase, integrator::PositionVerlet, forcing::Gravity,
+                          forcing::ElementTorques, forcing::TipLoad>;
+  using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+  using Pose = math::Pose<double>;
+  using Reward = reward::Sum<reward::DistanceReward<double>, reward::StabilityReward<double>>;
+
+  struct StepResult {
+    const control::Observation<double>& observation;
+    double reward;
+    bool done;
+    ReachInfo info;
+  };
+
+  ReachEnv(ReachEnvConfig config, Damping<double> damping)
+      : config_(config), damping_(damping),
+        nominal_(control::make_arm_model(config.rod, config.gripper_mass)),
+        statics_(nominal_, {}, config.limits) {
+    detail::require_positive("dt", config_.dt);
+    if (config_.substeps < 1) detail::fail("substeps = ", config_.substeps, " must be >= 1");
+    if (config_.horizon < 1) detail::fail("horizon = ", config_.horizon, " must be >= 1");
+    detail::require_non_negative("gripper_mass", config_.gripper_mass);
+    detail::require_non_negative("load_mass", config_.load_mass);
+    if (!std::isfinite(config_.model_error) || config_.model_error <= -0.9)
+      detail::fail("model_error = ", config_.model_error, " is invalid: it must be finite and > -0.9");
+    if (config_.observe_stride < 1) detail::fail("observe_stride = ", config_.observe_stride, " must be >= 1");
+    detail::require_positive("tolerance_position", config_.tolerance_position);
+    detail::require_positive("tolerance_rotation", config_.tolerance_rotation);
+    if (config_.hold_steps < 1) detail::fail("hold_steps = ", config_.hold_steps, " must be >= 1");
+    if (config_.stability_window < 1) detail::fail("stability_window = ", config_.stability_window, " must be >= 1");
+    const int n = config_.rod.n_elements;
+    int count = 0;
+    for (int j = 0; j <= n; j += config_.observe_stride) ++count;
+    const bool tip_missing = (n % config_.observe_stride) != 0;
+    observation_.node_indices.resize(count + (tip_missing ? 1 : 0));
+    int i = 0;
+    for (int j = 0; j <= n; j += config_.observe_stride) observation_.node_indices[i++] = j;
+    if (tip_missing) observation_.node_indices[i] = n;
+    observation_.node_positions.setZero(observation_.node_indices.size(), 3);
+    observation_.node_velocities.setZero(observation_.node_indices.size(), 3);
+    d_history_.setZero(config_.stability_window);
+    clipped_action_.setZero(n, 3);
+  }
+
+  /// The model an executor should assume: nominal stiffness, gripper payload, no load.
+  const control::ArmModel<double>& nominal_model() const { return nominal_; }
+  const ReachEnvConfig& config() const { return config_; }
+  int n_elements() const { return config_.rod.n_elements; }
+
+  /// Starts an episode: draws the target of `seed` and puts the arm straight at rest.
+  const control::Observation<double>& reset(std::uint64_t seed) {
+    target_ = draw_target(seed);
+    RodParameters<double> sim = config_.rod;
+    sim.youngs_modulus *= 1 + config_.model_error;
+    if (config_.rod.shear_modulus > 0) sim.shear_modulus *= 1 + config_.model_error;
+    forcing::TipLoad<double> tip;
+    tip.force_lab = forcing::Gravity<double>{}.acceleration * (config_.gripper_mass + config_.load_mass);
+    rod_.emplace(sim, config_.dt, damping_, forcing::Gravity<double>{}, forcing::ElementTorques<double>{}, tip);
+    reward_ = Reward{};
+    info_ = ReachInfo{};
+    held_ = 0;
+    d_count_ = 0;
+    fill_observation();
+    return observation_;
+  }
+
+  /// Applies `action` (n x 3, clamped to the limits) for one control step.
+  StepResult step(const Array3& action) {
+    if (!rod_) detail::fail("ReachEnv::step called before reset");
+    const int n = n_elements();
+    if (action.rows() != n || action.cols() != 3)
+      detail::fail("ReachEnv::step expects an action of ", n, " x 3, got ", action.rows(), " x ", action.cols());
+    info_.clipped = 0;
+    for (int k = 0; k < n; ++k)
+      for (int c = 0; c < 3; ++c) {
+        const double a = action(k, c);
+        if (!std::isfinite(a)) detail::fail("ReachEnv::step: action entry (", k, ", ", c, ") = ", a, " is not finite");
+        const double lim = k == 0 ? 0.0 : config_.limits.limit(c);
+        clipped_action_(k, c) = std::clamp(a, -lim, lim);
+        if (k > 0 && std::abs(a) > lim) ++info_.clipped;
+      }
+    rod_->template forcing<forcing::ElementTorques>().set(clipped_action_);
+    if (!info_.diverged) {
+      try {
+        for (int s = 0; s < config_.substeps; ++s) {
+          rod_->step();
+          const double d = reward::pose_error(end_effector(), target_).distance;
+          d_history_[d_count_ % config_.stability_window] = d;
+          ++d_count_;
+        }
+      } catch (const Error&) {
+        info_.diverged = true;
+      }
+    }
+    ++info_.step;
+    fill_observation();
+    info_.error = reward::pose_error(observation_.end_effector, target_);
+    info_.in_tolerance = !info_.diverged && info_.error.position_error < config_.tolerance_position &&
+                         info_.error.rotation_error < config_.tolerance_rotation;
+    held_ = info_.in_tolerance ? held_ + 1 : 0;
+    if (!info_.success && held_ >= config_.hold_steps) {
+      info_.success = true;
+      info_.first_success_step = info_.step - config_.hold_steps;
+    }
+    const reward::RewardInput<double> input{observation_.end_effector, target_,
+                                            config_.dt * config_.substeps, !info_.diverged};
+    const double r = reward_.evaluate(input).total;
+    const bool done = info_.diverged || info_.step >= config_.horizon;
+    return StepResult{observation_, r, done, info_};
+  }
+
+  const Pose& target() const { return target_; }
+  const ReachInfo& info() const { return info_; }
+  const Rod& rod() const { return *rod_; }
+  /// Variance of d over the last stability_window simulation steps (fewer if not yet run).
+  double stability_variance() const {
+    const long m = std::min<long>(d_count_, config_.stability_window);
+    if (m < 2) return 0;
+    double mean = 0;
+    for (long i = 0; i < m; ++i) mean += d_history_[i];
+    mean /= double(m);
+    double var = 0;
+    for (long i = 0; i < m; ++i) var += (d_history_[i] - mean) * (d_history_[i] - mean);
+    return var / double(m);
+  }
+  /// Candidate poses drawn for the last target (1 = the first was reachable).
+  int target_draws() const { return target_draws_; }
+
+  /// The target of `seed` in this environment's set (deterministic).
+  Pose draw_target(std::uint64_t seed) {
+    std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + 0x5EED);
+    for (target_draws_ = 1; target_draws_ <= 500; ++target_draws_) {
+      std::optional<Pose> candidate =
+          config_.target_set == TargetSet::table ? table_candidate(rng) : equilibrium_candidate(rng);
+      if (!candidate) continue;
+      const auto r = statics_.solve_cold(*candidate);
+      if (r.within_limits) return *candidate;
+    }
+    detail::fail("ReachEnv: no reachable target found for seed ", seed, " in 500 draws");
+  }
+
+ private:
+  static double uniform(std::mt19937_64& rng, double lo, double hi) {
+    return lo + (hi - lo) * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+  }
+
+  std::optional<Pose> table_candidate(std::mt19937_64& rng) const {
+    const double pi = std::numbers::pi;
+    const Eigen::Vector3d p(uniform(rng, 0.40, 0.85), uniform(rng, -0.25, 0.25), uniform(rng, -0.70, -0.30));
+    const double yaw = uniform(rng, -pi, pi);
+    const double tilt = std::acos(1 - uniform(rng, 0, 1) * (1 - std::cos(pi / 4)));
+    const double tilt_dir = uniform(rng, 0, 2 * pi);
+    Eigen::Matrix3d down;  // d1 = +x, d2 = -y, d3 = -z: the base frame bent down by 90 deg
+    down << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(tilt, Eigen::Vector3d(std::cos(tilt_dir), std::sin(tilt_dir), 0)).toRotationMatrix() *
+                              Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * down;
+    return Pose{r, p};
+  }
+
+  std::optional<Pose> equilibrium_candidate(std::mt19937_64& rng) const {
+    using SettleRod = CosseratRod<double, damping::UniformExp, bc::ClampedBase, integrator::PositionVerlet, forcing::Gravity,
+                                  forcing::ElementTorques, forcing::TipLoad>;
+    const int n = n_elements();
+    Array3 torques = Array3::Zero(n, 3);
+    for (int c = 0; c < 3; ++c) {
+      const double amplitude = c < 2 ? 10.0 : 4.0;
+      const double a0 = uniform(rng, -1, 1), a1 = uniform(rng, -1, 1), a2 = uniform(rng, -1, 1);
+      double peak = 0;
+      for (int k = 1; k < n; ++k) {
+        const double s = double(k) / double(n - 1);
+        torques(k, c) = a0 + a1 * s + a2 * s * s;
+        peak = std::max(peak, std::abs(torques(k, c)));
+      }
+      const double scale = amplitude * uniform(rng, 0, 1) / std::max(peak, 1e-12);
+      torques.col(c) *= scale;
+      torques(n - 1, c) += uniform(rng, -1, 1) * (c < 2 ? 60.0 : 20.0);
+    }
+    forcing::TipLoad<double> tip;
+    tip.force_lab = forcing::Gravity<double>{}.acceleration * config_.gripper_mass;
+    SettleRod rod(config_.rod, config_.dt, damping::UniformExp<double>(20.0), forcing::Gravity<double>{},
+                  forcing::ElementTorques<double>{}, tip);
+    rod.template forcing<forcing::ElementTorques>().set(torques);
+    const int steps = static_cast<int>(std::lround(4.0 / config_.dt));
+    try {
+      for (int i = 0; i < steps; ++i) rod.step();
+    } catch (const Error&) {
+      return std::nullopt;
+    }
+    const double speed = rod.state().velocities.rowwise().norm().maxCoeff();
+    const double spin = rod.state().angular_velocities.rowwise().norm().maxCoeff();
+    if (!(speed < 1e-4 && spin < 1e-3)) return std::nullopt;
+    return Pose{rod.state().director(n - 1).transpose(), rod.state().tip_position()};
+  }
+
+  Pose end_effector() const {
+    const auto& s = rod_->state();
+    return Pose{s.director(n_elements() - 1).transpose(), s.tip_position()};
+  }
+
+  void fill_observation() {
+    const auto& s = rod_->state();
+    observation_.target = target_;
+    observation_.end_effector = end_effector();
+    observation_.time = s.time;
+    for (Eigen::Index i = 0; i < observation_.node_indices.size(); ++i) {
+      observation_.node_positions.row(i) = s.positions.row(observation_.node_indices[i]);
+      observation_.node_velocities.row(i) = s.velocities.row(observation_.node_indices[i]);
+    }
+  }
+
+  ReachEnvConfig config_;
+  Damping<double> damping_;
+  control::ArmModel<double> nominal_;
+  control::InverseStatics<double> statics_;
+  std::optional<Rod> rod_;
+  Reward reward_;
+  Pose target_;
+  control::Observation<double> observation_;
+  ReachInfo info_;
+  int held_ = 0;
+  int target_draws_ = 0;
+  Eigen::VectorXd d_history_;
+  long d_count_ = 0;
+  Array3 clipped_action_;
+};
+
+}  // namespace manisoft::env
