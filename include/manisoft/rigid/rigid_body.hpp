@@ -61,6 +61,48 @@ struct RigidBodyState {
   bool awake{true};
 };
 
+/// Refuses shapes with non-positive or non-finite sizes; `who` names the body.
+inline void validate_shape(const Shape<double>& shape, const std::string& who) {
+  auto check = [&](const PrimitiveShape<double>& prim) {
+    std::visit(
+        [&](const auto& s) {
+          using S = std::decay_t<decltype(s)>;
+          if constexpr (std::is_same_v<S, Box<double>>) {
+            for (int i = 0; i < 3; ++i) detail::require_positive((who + ": box half extent").c_str(), s.half_extents[i]);
+          } else if constexpr (std::is_same_v<S, Sphere<double>>) {
+            detail::require_positive((who + ": sphere radius").c_str(), s.radius);
+          } else if constexpr (std::is_same_v<S, Capsule<double>>) {
+            detail::require_positive((who + ": capsule radius").c_str(), s.radius);
+            detail::require_non_negative((who + ": capsule half_length").c_str(), s.half_length);
+          } else if constexpr (std::is_same_v<S, Cylinder<double>>) {
+            detail::require_positive((who + ": cylinder radius").c_str(), s.radius);
+            detail::require_positive((who + ": cylinder half_height").c_str(), s.half_height);
+          } else {
+            for (const auto& v : s.vertices) {
+              if (!v.allFinite()) detail::fail(who, ": convex mesh '", s.source, "' has a non-finite vertex");
+            }
+          }
+        },
+        prim);
+  };
+  std::visit(
+      [&](const auto& s) {
+        using S = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<S, Compound<double>>) {
+          if (s.parts.empty()) detail::fail(who, ": compound shape has no parts");
+          for (const auto& part : s.parts) {
+            if (!part.position.allFinite() || !part.orientation.coeffs().allFinite() || part.orientation.norm() < 1e-9) {
+              detail::fail(who, ": compound part pose is not finite");
+            }
+            check(part.shape);
+          }
+        } else {
+          check(PrimitiveShape<double>(s));
+        }
+      },
+      shape);
+}
+
 /// Derives the model of a body from its description; `id` is used in error messages.
 inline RigidBodyModel make_body_model(const RigidBodyDesc& desc, BodyId id) {
   RigidBodyModel m;
@@ -75,6 +117,7 @@ inline RigidBodyModel make_body_model(const RigidBodyDesc& desc, BodyId id) {
       !desc.orientation.coeffs().allFinite() || desc.orientation.norm() < 1e-9) {
     detail::fail(who(), ": position, orientation and velocities must be finite (and the quaternion non-zero)");
   }
+  validate_shape(desc.shape, who());
   m.friction = desc.friction;
   m.restitution = desc.restitution;
   if (desc.is_static) {

@@ -122,7 +122,6 @@ class RigidWorld {
         mesh_origin = g.local.rotation.transpose() * (model.center_of_mass - pos);
         g.local.translation = Vec3::Zero();
       }
-      validate_primitive(prim, id, desc.name);
       g.shape = contact::make_collision_shape(prim, mesh_origin);
       model.bounding_radius = std::max(model.bounding_radius, g.local.translation.norm() + g.shape.bounding_radius);
       geoms_.push_back(std::move(g));
@@ -381,27 +380,8 @@ class RigidWorld {
   void check_id(BodyId id) const {
     if (id >= models_.size()) ::manisoft::detail::fail("rigid body id ", id, " out of range (", models_.size(), " bodies)");
   }
+  static bool is_round(contact::ShapeKind k) { return k == contact::ShapeKind::sphere || k == contact::ShapeKind::capsule; }
   bool is_moving(BodyId id) const { return !models_[id].is_static && states_[id].awake; }
-
-  static void validate_primitive(const PrimitiveShape<double>& prim, BodyId id, const std::string& name) {
-    const std::string who = "rigid body " + std::to_string(id) + (name.empty() ? "" : " ('" + name + "')");
-    std::visit(
-        [&](const auto& s) {
-          using S = std::decay_t<decltype(s)>;
-          if constexpr (std::is_same_v<S, Box<double>>) {
-            for (int i = 0; i < 3; ++i) ::manisoft::detail::require_positive((who + ": box half extent").c_str(), s.half_extents[i]);
-          } else if constexpr (std::is_same_v<S, Sphere<double>>) {
-            ::manisoft::detail::require_positive((who + ": sphere radius").c_str(), s.radius);
-          } else if constexpr (std::is_same_v<S, Capsule<double>>) {
-            ::manisoft::detail::require_positive((who + ": capsule radius").c_str(), s.radius);
-            ::manisoft::detail::require_non_negative((who + ": capsule half_length").c_str(), s.half_length);
-          } else if constexpr (std::is_same_v<S, Cylinder<double>>) {
-            ::manisoft::detail::require_positive((who + ": cylinder radius").c_str(), s.radius);
-            ::manisoft::detail::require_positive((who + ": cylinder half_height").c_str(), s.half_height);
-          }
-        },
-        prim);
-  }
 
   /// Recomputes the fat AABB of geometry g if its margin-inflated bounds left it (or if forced).
   bool refresh_fat_bounds(std::uint32_t g, bool force) {
@@ -462,7 +442,14 @@ class RigidWorld {
     for (auto& m : manifolds_) {
       const auto& sa = states_[m.body_a];
       const auto& sb = states_[m.body_b];
-      if (!m.fresh && (sa.travel - m.travel_a) + (sb.travel - m.travel_b) <= redetect) continue;
+      // Analytic pairs with a rounded shape are re-evaluated every step while a body moves: they
+      // cost well under a microsecond, and a rolling sphere's contact is not a material point
+      // (the cached extrapolation would let it sink). SAT and FCL pairs use the cache.
+      const auto ka = geoms_[m.geom_a].shape.kind, kb = geoms_[m.geom_b].shape.kind;
+      const bool analytic_round = (is_round(ka) && (is_round(kb) || kb == contact::ShapeKind::box)) ||
+                                  (is_round(kb) && ka == contact::ShapeKind::box);
+      const bool moving = is_moving(m.body_a) || is_moving(m.body_b);
+      if (!m.fresh && !(analytic_round && moving) && (sa.travel - m.travel_a) + (sb.travel - m.travel_b) <= redetect) continue;
       m.fresh = false;
       m.travel_a = sa.travel;
       m.travel_b = sb.travel;
