@@ -38,11 +38,13 @@ namespace manisoft::control {
 
 template <typename Scalar>
 struct ModelExecutorSettings {
-  Scalar damping_gain = Scalar(15);        ///< kd, 1/s (DESIGN.md 8: 10..20 works at 714 Hz, 40 is unstable)
-  Scalar outer_gain = Scalar(0.4);         ///< K per outer update (0 disables the outer loop)
+  Scalar damping_gain = Scalar(25);        ///< kd, 1/s
+  Scalar position_gain = Scalar(200);     ///< kp, 1/s^2: node force -kp m (x - x_desired), same mapping
+  Scalar outer_gain = Scalar(0.1);         ///< K per outer update (0 disables the outer loop)
   int outer_period = 20;                   ///< control steps between outer updates
   int outer_delay = 60;                    ///< control steps after the ramp before the first outer update
   int ramp_steps = 250;                    ///< control steps of the shape ramp to a new target
+  Scalar outer_speed_gate = Scalar(0.15);  ///< m/s: integrate only while every observed node is slower
   Scalar outer_max_shift = Scalar(0.3);    ///< bound on |p_s - p*| (m) and |log(R_s R*^T)| (rad)
 };
 
@@ -60,6 +62,8 @@ class ModelExecutor {
       : statics_(std::move(model), statics, limits), settings_(settings) {
     detail::require_non_negative("ModelExecutor damping_gain", settings_.damping_gain);
     detail::require_non_negative("ModelExecutor outer_gain", settings_.outer_gain);
+    detail::require_non_negative("ModelExecutor position_gain", settings_.position_gain);
+    if (settings_.ramp_steps < 0) detail::fail("ModelExecutor ramp_steps = ", settings_.ramp_steps, " must be >= 0");
     if (settings_.outer_period < 1) detail::fail("ModelExecutor outer_period = ", settings_.outer_period, " must be >= 1");
     if (settings_.outer_delay < 0) detail::fail("ModelExecutor outer_delay = ", settings_.outer_delay, " must be >= 0");
     detail::require_positive("ModelExecutor outer_max_shift", settings_.outer_max_shift);
@@ -97,7 +101,8 @@ class ModelExecutor {
     const auto& limits = statics_.limits();
     Vector3 distal = Vector3::Zero();
     for (int k = n - 1; k >= 0; --k) {
-      distal -= settings_.damping_gain * node_mass_[k + 1] * velocities_.row(k + 1).transpose();
+      distal -= node_mass_[k + 1] * (settings_.damping_gain * velocities_.row(k + 1).transpose() +
+                                     settings_.position_gain * (positions_.row(k + 1) - desired.positions.row(k + 1)).transpose());
       const Vector3 lever = (positions_.row(k + 1) - positions_.row(k)).transpose();
       // Material frame of element k estimated from the desired one, turned by the smallest
       // rotation that takes the desired element tangent onto the observed one.
@@ -139,20 +144,22 @@ class ModelExecutor {
     return a.translation == b.translation && a.rotation == b.rotation;
   }
 
-  /// Linear interpolation of the observed node positions and velocities onto every node.
+  /// Node positions and velocities of every node: the observed position errors (observed minus
+  /// desired) and velocities interpolated linearly between observed nodes (held constant past
+  /// the first/last observed node); positions = desired + interpolated error.
   void interpolate(const Observation<Scalar>& o) {
     const int n_nodes = statics_.n_elements() + 1;
+    const RodState<Scalar>& desired = statics_.desired_state();
     const auto m = o.node_indices.size();
     Eigen::Index seg = 0;
     for (int j = 0; j < n_nodes; ++j) {
       while (seg + 2 < m && o.node_indices[seg + 1] < j) ++seg;
       const int a = o.node_indices[seg], b = o.node_indices[seg + 1];
-      Scalar w = Scalar(j - a) / Scalar(b - a);
-      w = std::clamp(w, Scalar(0), Scalar(1));
-      positions_.row(j) = (Scalar(1) - w) * o.node_positions.row(seg) + w * o.node_positions.row(seg + 1);
+      const Scalar w = std::clamp(Scalar(j - a) / Scalar(b - a), Scalar(0), Scalar(1));
+      const Eigen::Matrix<Scalar, 1, 3> ea = o.node_positions.row(seg) - desired.positions.row(a);
+      const Eigen::Matrix<Scalar, 1, 3> eb = o.node_positions.row(seg + 1) - desired.positions.row(b);
+      positions_.row(j) = desired.positions.row(j) + (Scalar(1) - w) * ea + w * eb;
       velocities_.row(j) = (Scalar(1) - w) * o.node_velocities.row(seg) + w * o.node_velocities.row(seg + 1);
-      if (j > b) positions_.row(j) = o.node_positions.row(seg + 1), velocities_.row(j) = o.node_velocities.row(seg + 1);
-      if (j < a) positions_.row(j) = o.node_positions.row(seg), velocities_.row(j) = o.node_velocities.row(seg);
     }
   }
 
@@ -162,6 +169,9 @@ class ModelExecutor {
     e.template head<3>() = target_.translation - o.end_effector.translation;
     e.template tail<3>() = math::so3::log(target_.rotation * o.end_effector.rotation.transpose());
     if (!e.allFinite()) return;
+    // Integrate only while the arm is quasi-static: during transients the pose error is not the
+    // static error the shape shift should remove, and integrating it winds up the loop.
+    if (o.node_velocities.rowwise().norm().maxCoeff() > settings_.outer_speed_gate) return;
     error_sum_ += e;
     ++error_count_;
     if (error_count_ < settings_.outer_period) return;

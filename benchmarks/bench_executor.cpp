@@ -1,0 +1,59 @@
+// Executor compute (issue 4): the model executor's per-control-step cost (feedback, ramp or
+// outer-loop re-solves amortized as they occur) and the per-target set-up (cold inverse statics),
+// and one MLP policy step of a 90-64-64-60 network.
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+#include "manisoft/control/mlp_executor.hpp"
+#include "manisoft/control/model_executor.hpp"
+#include "manisoft/env/reach_env.hpp"
+
+namespace {
+
+using Env = manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear>;
+using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+
+/// Per control step over whole episodes: the executor is timed, the simulation is not.
+void BM_ModelExecutorStep(benchmark::State& state) {
+  Env env({}, manisoft::damping::AnalyticalLinear<double>(0.1));
+  manisoft::control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits);
+  Array3 action = Array3::Zero(env.n_elements(), 3);
+  std::uint64_t seed = 1;
+  const auto* observation = &env.reset(seed);
+  executor.reset();
+  executor.act(*observation, action);  // set-up outside the timed loop
+  int t = 0;
+  for (auto _ : state) {
+    executor.act(*observation, action);
+    benchmark::DoNotOptimize(action.data());
+    state.PauseTiming();
+    observation = &env.step(action).observation;
+    if (++t == env.config().horizon) {
+      t = 0;
+      observation = &env.reset(++seed);
+      executor.reset();
+      executor.act(*observation, action);
+    }
+    state.ResumeTiming();
+  }
+}
+BENCHMARK(BM_ModelExecutorStep)->Unit(benchmark::kMicrosecond)->Iterations(15000);
+
+/// Per target: the cold inverse statics solve for a new table target.
+void BM_ModelExecutorSetup(benchmark::State& state) {
+  Env env({}, manisoft::damping::AnalyticalLinear<double>(0.1));
+  std::vector<manisoft::math::Pose<double>> targets;
+  for (std::uint64_t s = 0; s < 50; ++s) targets.push_back(env.draw_target(s));
+  manisoft::control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    executor.reset();
+    benchmark::DoNotOptimize(executor.set_target(targets[i++ % targets.size()]));
+  }
+}
+BENCHMARK(BM_ModelExecutorSetup)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

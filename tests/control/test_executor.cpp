@@ -1,0 +1,229 @@
+// Executors (issue 4): the inverse statics shape is an exact equilibrium of the simulated rod,
+// the model executor reaches targets of the reach environment, the MLP policy reproduces
+// hand-computed outputs and refuses malformed weight files, and bad targets are refused.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include "manisoft/control/executor.hpp"
+#include "manisoft/control/inverse_statics.hpp"
+#include "manisoft/control/mlp_executor.hpp"
+#include "manisoft/control/model_executor.hpp"
+#include "manisoft/env/reach_env.hpp"
+#include "manisoft/rod.hpp"
+
+namespace {
+
+namespace control = manisoft::control;
+using Pose = manisoft::math::Pose<double>;
+using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+using Rod = manisoft::CosseratRod<double, manisoft::damping::None, manisoft::bc::ClampedBase, manisoft::integrator::PositionVerlet,
+                                  manisoft::forcing::Gravity, manisoft::forcing::ElementTorques, manisoft::forcing::TipLoad>;
+
+static_assert(control::Executor<control::ModelExecutor<double>>);
+static_assert(control::Executor<control::MlpExecutor<double>>);
+static_assert(!control::Executor<int>);
+
+/// A gripper-down pose over the table region, reachable within the default limits.
+Pose table_pose() {
+  Eigen::Matrix3d down;
+  down << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+  return Pose{Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.6, 0.8, 0)).toRotationMatrix() * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix() * down,
+              Eigen::Vector3d(0.62, 0.1, -0.5)};
+}
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / ("manisoft_test_" + name);
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+}  // namespace
+
+TEST_CASE("inverse statics meets the target pose and its shape is an exact equilibrium", "[executor][statics]") {
+  const auto params = manisoft::RodParameters<double>{};
+  const auto model = control::make_arm_model(params, 0.2);
+  control::InverseStatics<double> statics(model, {}, {150, 75});
+  const Pose target = table_pose();
+  const auto result = statics.solve_cold(target);
+  REQUIRE(result.converged);
+  CHECK(result.within_limits);
+  CHECK(result.position_error < 1e-9);
+  CHECK(result.rotation_error < 1e-9);
+  const Pose tip = statics.desired_tip_pose();
+  CHECK((tip.translation - target.translation).norm() < 1e-9);
+  CHECK((tip.rotation - target.rotation).norm() < 1e-9);
+  CHECK(statics.feedforward().row(0).norm() == 0.0);
+
+  // Start AT the desired shape, feed-forward alone, no damping: the tip must not move.
+  manisoft::forcing::TipLoad<double> payload;
+  payload.force_lab = model.gravity * model.payload_mass;
+  Rod rod(model.rod, statics.desired_state(), 2e-4, false, manisoft::damping::None<double>{}, manisoft::forcing::Gravity<double>{},
+          manisoft::forcing::ElementTorques<double>{}, payload);
+  rod.forcing<manisoft::forcing::ElementTorques>().set(statics.feedforward());
+  const Eigen::Vector3d start = rod.tip_position();
+  double drift = 0;
+  for (int i = 0; i < 5000; ++i) {  // 1 s
+    rod.step();
+    drift = std::max(drift, (rod.tip_position() - start).norm());
+  }
+  CAPTURE(drift);
+  CHECK(drift < 1e-9);
+}
+
+TEST_CASE("inverse statics warm start re-solves a nearby target in few iterations", "[executor][statics]") {
+  control::InverseStatics<double> statics(control::make_arm_model(manisoft::RodParameters<double>{}, 0.2), {}, {150, 75});
+  Pose target = table_pose();
+  REQUIRE(statics.solve_cold(target).converged);
+  target.translation += Eigen::Vector3d(0.01, -0.01, 0.005);
+  const auto r = statics.solve(target);
+  CHECK(r.converged);
+  CHECK(r.iterations < 20);
+}
+
+TEST_CASE("bad targets are refused", "[executor][input]") {
+  const auto model = control::make_arm_model(manisoft::RodParameters<double>{}, 0.2);
+  control::InverseStatics<double> statics(model);
+  Pose bad = table_pose();
+  bad.translation.x() = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(statics.solve_cold(bad), manisoft::Error);
+  Pose skewed = table_pose();
+  skewed.rotation(0, 0) = 2;
+  CHECK_THROWS_AS(statics.solve(skewed), manisoft::Error);
+
+  manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> env({}, manisoft::damping::AnalyticalLinear<double>(0.1));
+  control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits);
+  control::Observation<double> o = env.reset(3);
+  Array3 action = Array3::Zero(env.n_elements(), 3);
+  o.target.translation.y() = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH(executor.act(o, action), Catch::Contains("target pose refused"));
+  o = env.reset(3);
+  o.node_indices[1] = 0;  // not ascending
+  CHECK_THROWS_AS(executor.act(o, action), manisoft::Error);
+}
+
+TEST_CASE("reach environment targets are deterministic per seed", "[executor][env]") {
+  manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> a({}, manisoft::damping::AnalyticalLinear<double>(0.1));
+  manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> b({}, manisoft::damping::AnalyticalLinear<double>(0.1));
+  CHECK(a.reset(11).target.translation == b.reset(11).target.translation);
+  CHECK(a.reset(12).target.translation != b.reset(11).target.translation);
+  CHECK(manisoft::env::parse_target_set("equilibria") == manisoft::env::TargetSet::equilibria);
+  CHECK_THROWS_AS(manisoft::env::parse_target_set("tabel"), manisoft::Error);
+}
+
+TEST_CASE("the model executor reaches and holds table targets", "[executor][reach]") {
+  manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> env({}, manisoft::damping::AnalyticalLinear<double>(0.1));
+  control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits);
+  Array3 action = Array3::Zero(env.n_elements(), 3);
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    const auto* observation = &env.reset(seed);
+    executor.reset();
+    manisoft::env::ReachInfo info;
+    for (int t = 0; t < env.config().horizon; ++t) {
+      executor.act(*observation, action);
+      const auto result = env.step(action);
+      observation = &result.observation;
+      info = result.info;
+      if (result.done) break;
+    }
+    CAPTURE(seed, info.error.position_error, info.error.rotation_error);
+    CHECK(info.success);
+    CHECK(info.error.position_error < 0.01);
+    CHECK(info.error.rotation_error < 0.1);
+  }
+}
+
+TEST_CASE("MLP reproduces hand-computed outputs", "[executor][mlp]") {
+  // 2 inputs -> 2 relu -> 1 tanh -> 2 linear
+  const std::string path = write_file("mlp_ok.txt",
+                                      "# test network\n"
+                                      "manisoft-mlp 1\n"
+                                      "layers 3\n"
+                                      "input 2\n"
+                                      "layer 2 relu\n"
+                                      "1 -1   # row 0\n"
+                                      "0.5 2\n"
+                                      "0 -1\n"
+                                      "\n"
+                                      "layer 1 tanh\n"
+                                      "1 0.5\n"
+                                      "0.1\n"
+                                      "layer 2 linear\n"
+                                      "2\n"
+                                      "-3\n"
+                                      "1 0\n");
+  auto mlp = control::Mlp<double>::load(path);
+  CHECK(mlp.input_size() == 2);
+  CHECK(mlp.output_size() == 2);
+  Eigen::VectorXd x(2);
+  x << 3, 1;
+  // h1 = relu([3 - 1 + 0, 1.5 + 2 - 1]) = [2, 2.5]; h2 = tanh(2 + 1.25 + 0.1) = tanh(3.35)
+  const double h2 = std::tanh(3.35);
+  const auto& y = mlp.evaluate(x);
+  CHECK(y[0] == Approx(2 * h2 + 1).epsilon(1e-14));
+  CHECK(y[1] == Approx(-3 * h2).epsilon(1e-14));
+  x << -2, 1;  // h1 = relu([-3, 0]) = [0, 0]; h2 = tanh(0.1)
+  const auto& y2 = mlp.evaluate(x);
+  CHECK(y2[0] == Approx(2 * std::tanh(0.1) + 1).epsilon(1e-14));
+  CHECK(y2[1] == Approx(-3 * std::tanh(0.1)).epsilon(1e-14));
+}
+
+TEST_CASE("MLP executor maps features to clamped torques", "[executor][mlp]") {
+  // 24 + 6 * 2 = 36 features for 2 observed nodes; 3 elements -> 9 outputs; one linear layer
+  // whose output k is 100 * feature k (feature 0 = target x).
+  std::string text = "manisoft-mlp 1\nlayers 1\ninput 36\nlayer 9 linear\n";
+  for (int i = 0; i < 9; ++i) {
+    for (int j = 0; j < 36; ++j) text += (i == j ? "100 " : "0 ");
+    text += "\n";
+  }
+  text += "0 0 0 0 0 0 0 0 1\n";
+  control::MlpExecutor<double> executor(control::Mlp<double>::load(write_file("mlp_exec.txt", text)), 3, {150, 75});
+  control::Observation<double> o;
+  o.target.translation = Eigen::Vector3d(0.5, -2, 0.25);
+  o.node_indices.resize(2);
+  o.node_indices << 0, 3;
+  o.node_positions = Eigen::Matrix<double, 2, 3>::Zero();
+  o.node_velocities = Eigen::Matrix<double, 2, 3>::Zero();
+  Array3 action = Array3::Zero(3, 3);
+  executor.act(o, action);
+  // Element 0 is clamped: 0. Element 1: features 3..5 = target rotation column 0 = (1, 0, 0).
+  CHECK(action.row(0).norm() == 0.0);
+  CHECK(action(1, 0) == Approx(100));
+  CHECK(action(1, 1) == Approx(0).margin(1e-12));
+  // Element 2: features 6..8 = (0, 1, 0) -> (0, 100, 0) plus bias 1 on the twist.
+  CHECK(action(2, 1) == Approx(100));
+  CHECK(action(2, 2) == Approx(1));
+  o.target.translation.x() = 10;  // output 1000 N m on element 0 only (clamped anyway)
+  executor.act(o, action);
+  CHECK(action(0, 0) == 0.0);
+  CHECK_THROWS_AS(control::MlpExecutor<double>(control::Mlp<double>::load(write_file("mlp_exec2.txt", text)), 4, {}), manisoft::Error);
+}
+
+TEST_CASE("malformed MLP weight files are refused with file and line", "[executor][mlp][input]") {
+  struct Case {
+    const char* name;
+    const char* text;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"bad_header", "mlp 1\n", ":1:"},
+      {"bad_version", "manisoft-mlp 2\n", "version"},
+      {"bad_layers", "manisoft-mlp 1\nlayers zero\n", ":2:"},
+      {"short_row", "manisoft-mlp 1\nlayers 1\ninput 2\nlayer 1 linear\n1\n0\n", ":5:"},
+      {"bad_number", "manisoft-mlp 1\nlayers 1\ninput 2\nlayer 1 linear\n1 x\n0\n", "'x' is not a number"},
+      {"nan", "manisoft-mlp 1\nlayers 1\ninput 1\nlayer 1 linear\nnan\n0\n", "not finite"},
+      {"activation", "manisoft-mlp 1\nlayers 1\ninput 1\nlayer 1 swish\n1\n0\n", "unknown activation 'swish'"},
+      {"truncated", "manisoft-mlp 1\nlayers 2\ninput 1\nlayer 1 linear\n1\n0\n", "unexpected end of file"},
+      {"trailing", "manisoft-mlp 1\nlayers 1\ninput 1\nlayer 1 linear\n1\n0\n5\n", ":7:"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = write_file(std::string(c.name) + ".txt", c.text);
+    CAPTURE(c.name);
+    CHECK_THROWS_WITH(control::Mlp<double>::load(path), Catch::Contains(path) && Catch::Contains(c.expected));
+  }
+  CHECK_THROWS_WITH(control::Mlp<double>::load("/nonexistent/weights.txt"), Catch::Contains("/nonexistent/weights.txt"));
+}
