@@ -1,0 +1,227 @@
+// ArmWorld: the ManiSoft scene (paper section 3.1-3.3): a SoftArmWorld (Cosserat rod + RigidWorld
+// + elastic spring coupling) whose rod elements touch the world as capsules
+// (rod_contact::Capsules), a ParallelGripper as end-effector with state S, a table, static
+// obstacles and dynamic objects.
+//
+//   using Rod = CosseratRod<double, damping::AnalyticalLinear, bc::ClampedBase,
+//                           integrator::PositionVerlet, forcing::Gravity, forcing::ElementTorques>;
+//   ArmWorld<Rod> world(Rod(params, 2e-4, damping), ArmWorldSettings{});
+//   world.add_table({...});  world.add_object(desc);
+//   world.control_step(torques, S);   // 7 substeps (714 Hz) with the torques and gripper state S
+//
+// Step: gripper pre-step (S transitions, weld wrench on the held object), then the SoftArmWorld
+// step (coupling, rod contact, rod step, rigid step), then monitoring.
+// Reporting, never a crash: a non-finite state throws manisoft::Error naming the step and the rod
+// node/element or the rigid body (with its name); objects that leave the table top (centre of mass
+// outside its rectangle or below its surface) or the workspace box, and grasp, release and slip
+// events, are appended to events(); a fallen object keeps being simulated (the optional floor
+// catches it).
+// Deterministic: the same calls give bit-identical states (no threads, no unordered containers,
+// bodies and geometries visited in index order).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "manisoft/world/gripper.hpp"
+#include "manisoft/world/rod_contact.hpp"
+#include "manisoft/world/soft_arm_world.hpp"
+
+namespace manisoft {
+
+struct ArmWorldSettings {
+  RigidWorldSettings rigid{};
+  ParallelGripperParameters gripper{};
+  coupling::ElasticSpringParameters coupling = coupling::ElasticSpringParameters::stiff();
+  rod_contact::CapsuleParameters rod_contact{};
+  int substeps_per_control_step = 7;  ///< 714 Hz at dt = 2e-4 s (paper)
+  Eigen::Vector3d workspace_lo{-3, -3, -1};
+  Eigen::Vector3d workspace_hi{3, 3, 4};
+};
+
+/// A table: a static box whose top face is centred at `top_center`, horizontal.
+struct TableDesc {
+  Eigen::Vector3d top_center{0.4, 0, 0.75};
+  double half_x = 0.4, half_y = 0.5;  ///< m, of the top
+  double thickness = 0.05;            ///< m (the collision box below the top face)
+  double friction = 0.6;
+  bool add_floor = true;              ///< a static floor at z = 0 catches fallen objects
+};
+
+struct WorldEvent {
+  enum class Kind { grasped, released, slipped, left_table, left_workspace };
+  Kind kind{Kind::grasped};
+  long step = 0;
+  double time = 0;
+  BodyId body = 0;
+  std::string name;
+};
+
+inline const char* to_string(WorldEvent::Kind k) {
+  switch (k) {
+    case WorldEvent::Kind::grasped: return "grasped";
+    case WorldEvent::Kind::released: return "released";
+    case WorldEvent::Kind::slipped: return "slipped";
+    case WorldEvent::Kind::left_table: return "left_table";
+    case WorldEvent::Kind::left_workspace: return "left_workspace";
+  }
+  return "?";
+}
+
+template <typename Rod>
+class ArmWorld {
+ public:
+  using Vec3 = Eigen::Vector3d;
+  using Soft = SoftArmWorld<Rod, coupling::ElasticSpring, rod_contact::Capsules>;
+
+  ArmWorld(Rod rod, const ArmWorldSettings& settings = {})
+      : settings_(settings),
+        soft_(std::move(rod), settings.rigid, make_parallel_gripper(settings.gripper), coupling::ElasticSpring(settings.coupling),
+              rod_contact::Capsules(settings.rod_contact)),
+        gripper_(settings.gripper) {
+    if (settings_.substeps_per_control_step < 1) {
+      detail::fail("ArmWorldSettings::substeps_per_control_step = ", settings_.substeps_per_control_step, " must be >= 1");
+    }
+    gripper_.attach(soft_.end_effector());
+    soft_.rod_contact().exclude(soft_.end_effector());  // the coupling joins them
+    soft_.set_workspace(settings_.workspace_lo, settings_.workspace_hi);
+  }
+
+  // ---- scene building
+  /// Adds the table (and, if asked, a floor at z = 0); returns the table's body id.
+  BodyId add_table(const TableDesc& t) {
+    detail::require_positive("TableDesc half_x", t.half_x);
+    detail::require_positive("TableDesc half_y", t.half_y);
+    detail::require_positive("TableDesc thickness", t.thickness);
+    if (!t.top_center.allFinite()) detail::fail("TableDesc top_center is not finite");
+    RigidBodyDesc d;
+    d.shape = Box<double>{Vec3(t.half_x, t.half_y, 0.5 * t.thickness)};
+    d.position = t.top_center - Vec3(0, 0, 0.5 * t.thickness);
+    d.is_static = true;
+    d.friction = t.friction;
+    d.name = "table";
+    table_ = t;
+    table_id_ = soft_.rigid().add_body(d);
+    has_table_ = true;
+    if (t.add_floor) {
+      RigidBodyDesc f;
+      f.shape = Box<double>{Vec3(4, 4, 0.05)};
+      f.position = Vec3(t.top_center.x(), t.top_center.y(), -0.05);
+      f.is_static = true;
+      f.friction = t.friction;
+      f.name = "floor";
+      soft_.rigid().add_body(f);
+    }
+    return table_id_;
+  }
+  /// Adds a static obstacle.
+  BodyId add_obstacle(RigidBodyDesc d) {
+    d.is_static = true;
+    return soft_.rigid().add_body(d);
+  }
+  /// Adds a dynamic object (monitored: leaving the table or the workspace is reported).
+  BodyId add_object(const RigidBodyDesc& d) {
+    if (d.is_static) detail::fail("ArmWorld::add_object: '", d.name, "' is static; use add_obstacle");
+    const BodyId id = soft_.rigid().add_body(d);
+    objects_.push_back(id);
+    off_table_.push_back(false);
+    outside_.push_back(false);
+    return id;
+  }
+
+  // ---- stepping
+  /// Gripper command S in {0, 1}, effective from the next step.
+  void set_gripper(int s) { gripper_.command(s); }
+
+  void step() {
+    gripper_.pre_step(soft_.rigid(), double(soft_.rod().dt()));
+    if (gripper_.grasped_now()) record(WorldEvent::Kind::grasped, *gripper_.held());
+    if (gripper_.released_now()) {
+      record(gripper_.slipped() ? WorldEvent::Kind::slipped : WorldEvent::Kind::released, *gripper_.last_released());
+    }
+    soft_.step();
+    monitor();
+  }
+  void step(int count) {
+    for (int i = 0; i < count; ++i) step();
+  }
+  /// One control step: element torques (n x 3, material frame) and gripper state S, then
+  /// substeps_per_control_step substeps.
+  template <typename Matrix>
+  void control_step(const Matrix& torques, int s)
+    requires requires(Rod& r) { r.template forcing<forcing::ElementTorques>(); }
+  {
+    soft_.rod().template forcing<forcing::ElementTorques>().set(torques);
+    set_gripper(s);
+    step(settings_.substeps_per_control_step);
+  }
+
+  // ---- access
+  Soft& soft() { return soft_; }
+  const Soft& soft() const { return soft_; }
+  Rod& rod() { return soft_.rod(); }
+  const Rod& rod() const { return soft_.rod(); }
+  RigidWorld& rigid() { return soft_.rigid(); }
+  const RigidWorld& rigid() const { return soft_.rigid(); }
+  ParallelGripper& gripper() { return gripper_; }
+  const ParallelGripper& gripper() const { return gripper_; }
+  BodyId gripper_body() const { return soft_.end_effector(); }
+  rod_contact::Capsules& rod_contact() { return soft_.rod_contact(); }
+  const std::vector<BodyId>& objects() const { return objects_; }
+  const std::vector<WorldEvent>& events() const { return events_; }
+  bool has_table() const { return has_table_; }
+  BodyId table() const { return table_id_; }
+  const TableDesc& table_desc() const { return table_; }
+  const ArmWorldSettings& settings() const { return settings_; }
+  long step_count() const { return soft_.step_count(); }
+  double time() const { return soft_.time(); }
+  /// Whether object `id` is currently counted as off the table (see events()).
+  bool is_off_table(BodyId id) const {
+    for (std::size_t i = 0; i < objects_.size(); ++i) {
+      if (objects_[i] == id) return off_table_[i];
+    }
+    detail::fail("ArmWorld::is_off_table: body ", id, " is not an object");
+  }
+
+ private:
+  void record(WorldEvent::Kind kind, BodyId body) {
+    WorldEvent e;
+    e.kind = kind;
+    e.step = soft_.step_count();
+    e.time = soft_.time();
+    e.body = body;
+    e.name = soft_.rigid().model(body).name;
+    events_.push_back(std::move(e));
+  }
+
+  void monitor() {
+    const auto& rigid = soft_.rigid();
+    const auto& outside = soft_.outside_workspace();
+    for (std::size_t i = 0; i < objects_.size(); ++i) {
+      const BodyId b = objects_[i];
+      if (has_table_) {
+        const Vec3 x = rigid.center_of_mass(b);
+        const Vec3 d = x - table_.top_center;
+        const bool held = gripper_.held() && *gripper_.held() == b;
+        const bool off = !held && (std::abs(d.x()) > table_.half_x || std::abs(d.y()) > table_.half_y || d.z() < 0);
+        if (off && !off_table_[i]) record(WorldEvent::Kind::left_table, b);
+        off_table_[i] = off;
+      }
+      const bool out = std::find(outside.begin(), outside.end(), b) != outside.end();
+      if (out && !outside_[i]) record(WorldEvent::Kind::left_workspace, b);
+      outside_[i] = out;
+    }
+  }
+
+  ArmWorldSettings settings_;
+  Soft soft_;
+  ParallelGripper gripper_;
+  TableDesc table_;
+  BodyId table_id_ = 0;
+  bool has_table_ = false;
+  std::vector<BodyId> objects_;
+  std::vector<bool> off_table_, outside_;
+  std::vector<WorldEvent> events_;
+};
+
+}  // namespace manisoft

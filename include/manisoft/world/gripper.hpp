@@ -1,0 +1,293 @@
+// ParallelGripper: the paper's end-effector with state S in {0, 1} (section 3.2, action
+// A_t = (tau_e, S)): a rigid compound body (palm box and two finger boxes, all colliding with the
+// world) and a grasp mechanism.
+//
+// Geometry, in the gripper's shape frame (= the attachment frame, see make_parallel_gripper):
+// origin at the centre of the palm's top face, where the rod tip meets it; +z (the tip's d3)
+// points into the palm and on along the fingers; +x (d1) is the closing axis; y = z x x (d2).
+// The palm spans z in [0, palm_thickness]; the fingers hang below it, from z = palm_thickness to
+// palm_thickness + finger_length, their inner faces at x = +-open_width / 2. The grasp region is
+// the box between the inner faces over the fingers' length and width.
+//
+// Grasp mechanism (honest, not friction): the fingers' collision shapes stay at the open width.
+// When S goes 0 -> 1, the dynamic body whose geometry overlaps the grasp region deepest (ties:
+// lowest id) is welded to the gripper at its current relative pose by a stiff 6-DoF
+// spring-damper (like the coupling):
+//   F = -k (x_o - x_a) - c (v_o - v_a),  M = -k_r Log(R_o R_a^T) - c_r (w_o - w_g)     (lab)
+// on the object at its centre of mass x_o, the opposite force at x_o on the gripper and the
+// opposite torque (so the pair conserves momentum); x_a, R_a: the object's pose frozen in the
+// gripper frame at the grasp. The held object keeps colliding with everything (table, obstacles,
+// other objects, the rod). Closing on nothing grasps nothing (and a closed gripper picks up nothing
+// it bumps into later); S 1 -> 0 removes the weld. A real grip holds only up to its friction
+// force: when the spring force |k dx| exceeds max_hold_force (or |k_r dtheta| max_hold_torque)
+// the object slips out and the grasp ends (reported by `slipped()`). The visible finger width is
+// open_width when open, the object's extent along the closing axis when holding, 0 when closed
+// on nothing (finger_width(); the collision fingers do not move).
+//
+// Stability (explicit forces at dt = 2e-4 s): k and k_r are capped at grasp time so that
+// sqrt(k / m_eff) dt and sqrt(k_r / I_eff) dt stay <= max_omega_dt (0.25) on the pair's reduced
+// mass and smallest principal inertia; damping is zeta = 0.7 of critical. For the defaults and a
+// 0.1 kg, 5 cm cube (I = 4.2e-5 kg m^2): k = 2e4 N/m (omega dt = 0.11), k_r = 6.7 N m/rad (capped).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include "manisoft/contact/narrow_phase.hpp"
+#include "manisoft/core/error.hpp"
+#include "manisoft/math/so3.hpp"
+#include "manisoft/rigid/rigid_world.hpp"
+#include "manisoft/world/soft_arm_world.hpp"
+
+namespace manisoft {
+
+struct ParallelGripperParameters {
+  double palm_half_x = 0.06;       ///< m, along the closing axis
+  double palm_half_y = 0.04;       ///< m
+  double palm_thickness = 0.02;    ///< m, along the approach axis
+  double finger_thickness = 0.01;  ///< m, along the closing axis
+  double finger_half_width = 0.02; ///< m, along y
+  double finger_length = 0.07;     ///< m, below the palm
+  double open_width = 0.10;        ///< m, between the inner finger faces
+  double mass = 0.2;               ///< kg (the coupling's design load)
+  double friction = 0.8;
+  double weld_stiffness = 2e4;            ///< N/m
+  double weld_rotational_stiffness = 50;  ///< N m/rad
+  double weld_damping_ratio = 0.7;
+  double max_omega_dt = 0.25;      ///< cap on the weld's stiffness (explicit stability)
+  double max_hold_force = 40;      ///< N: grip friction limit (2 fingers x 25 N x mu 0.8)
+  double max_hold_torque = 1.5;    ///< N m
+
+  void validate() const {
+    detail::require_positive("ParallelGripper palm_half_x", palm_half_x);
+    detail::require_positive("ParallelGripper palm_half_y", palm_half_y);
+    detail::require_positive("ParallelGripper palm_thickness", palm_thickness);
+    detail::require_positive("ParallelGripper finger_thickness", finger_thickness);
+    detail::require_positive("ParallelGripper finger_half_width", finger_half_width);
+    detail::require_positive("ParallelGripper finger_length", finger_length);
+    detail::require_positive("ParallelGripper open_width", open_width);
+    detail::require_positive("ParallelGripper mass", mass);
+    detail::require_non_negative("ParallelGripper friction", friction);
+    detail::require_positive("ParallelGripper weld_stiffness", weld_stiffness);
+    detail::require_positive("ParallelGripper weld_rotational_stiffness", weld_rotational_stiffness);
+    detail::require_non_negative("ParallelGripper weld_damping_ratio", weld_damping_ratio);
+    detail::require_positive("ParallelGripper max_omega_dt", max_omega_dt);
+    if (!(max_omega_dt <= 0.5)) detail::fail("ParallelGripper max_omega_dt = ", max_omega_dt, " must be <= 0.5");
+    detail::require_positive("ParallelGripper max_hold_force", max_hold_force);
+    detail::require_positive("ParallelGripper max_hold_torque", max_hold_torque);
+    if (palm_half_x < 0.5 * open_width + finger_thickness - 1e-9) {
+      detail::fail("ParallelGripper palm_half_x = ", palm_half_x, " must cover the fingers (open_width / 2 + finger_thickness = ",
+                   0.5 * open_width + finger_thickness, ")");
+    }
+  }
+  /// Centre of the grasp region in the gripper frame.
+  Eigen::Vector3d grasp_center() const { return {0, 0, palm_thickness + 0.5 * finger_length}; }
+  Eigen::Vector3d grasp_half_extents() const { return {0.5 * open_width, finger_half_width, 0.5 * finger_length}; }
+};
+
+/// The gripper as an end-effector: compound body (palm + two fingers), attached at the palm's top
+/// centre with the attach frame equal to the shape frame (d1 = x closing axis, d3 = z approach).
+inline EndEffectorDesc make_parallel_gripper(const ParallelGripperParameters& p = {}) {
+  p.validate();
+  Compound<double> c;
+  CompoundPart<double> palm;
+  palm.shape = Box<double>{Eigen::Vector3d(p.palm_half_x, p.palm_half_y, 0.5 * p.palm_thickness)};
+  palm.position = Eigen::Vector3d(0, 0, 0.5 * p.palm_thickness);
+  c.parts.push_back(palm);
+  for (double side : {-1.0, 1.0}) {
+    CompoundPart<double> finger;
+    finger.shape = Box<double>{Eigen::Vector3d(0.5 * p.finger_thickness, p.finger_half_width, 0.5 * p.finger_length)};
+    finger.position = Eigen::Vector3d(side * (0.5 * p.open_width + 0.5 * p.finger_thickness), 0,
+                                      p.palm_thickness + 0.5 * p.finger_length);
+    c.parts.push_back(finger);
+  }
+  EndEffectorDesc ee;
+  ee.body.shape = c;
+  ee.body.mass = p.mass;
+  ee.body.friction = p.friction;
+  ee.body.name = "gripper";
+  ee.attach_position.setZero();
+  ee.attach_rotation.setIdentity();
+  return ee;
+}
+
+/// Grasp state machine and weld of a ParallelGripper body (see the header comment).
+class ParallelGripper {
+ public:
+  using Vec3 = Eigen::Vector3d;
+  using Mat3 = Eigen::Matrix3d;
+
+  ParallelGripper() : ParallelGripper(ParallelGripperParameters{}) {}
+  explicit ParallelGripper(const ParallelGripperParameters& p) : params_(p) {
+    params_.validate();
+    region_ = contact::make_collision_shape(Box<double>{params_.grasp_half_extents()});
+  }
+
+  const ParallelGripperParameters& parameters() const { return params_; }
+  /// The rigid body that carries the gripper geometry (made from make_parallel_gripper).
+  void attach(BodyId body) { body_ = body; }
+  BodyId body() const { return body_; }
+
+  /// Commands S (0 open, 1 closed); takes effect at the next pre_step.
+  void command(int s) {
+    if (s != 0 && s != 1) detail::fail("ParallelGripper::command: S = ", s, " must be 0 (open) or 1 (closed)");
+    command_ = s;
+  }
+  int command_state() const { return command_; }
+  /// The state S the gripper is in (after the last pre_step).
+  int state() const { return state_; }
+  std::optional<BodyId> held() const { return held_; }
+  /// Visible distance between the fingers [m] (see the header comment).
+  double finger_width() const { return state_ == 0 ? params_.open_width : (held_ ? held_width_ : 0.0); }
+  /// The weld wrench on the held object in the last step (lab) and its elastic parts.
+  const Vec3& weld_force() const { return weld_force_; }
+  const Vec3& weld_torque() const { return weld_torque_; }
+  double weld_elastic_force() const { return elastic_force_; }
+  /// Events of the last pre_step.
+  bool grasped_now() const { return grasped_now_; }
+  bool released_now() const { return released_now_; }
+  bool slipped() const { return slipped_; }
+  std::optional<BodyId> last_released() const { return last_released_; }
+
+  /// World pose of the grasp region centre.
+  Vec3 grasp_point(const RigidWorld& world) const {
+    return world.position(body_) + world.orientation(body_).toRotationMatrix() * params_.grasp_center();
+  }
+
+  /// The dynamic body overlapping the grasp region deepest, if any (no side effects).
+  std::optional<BodyId> find_graspable(RigidWorld& world) {
+    const Mat3 rg = world.orientation(body_).toRotationMatrix();
+    contact::Pose region_pose;
+    region_pose.rotation = rg;
+    region_pose.translation = world.position(body_) + rg * params_.grasp_center();
+    std::optional<BodyId> best;
+    double best_depth = -1;
+    for (BodyId b = 0; b < world.body_count(); ++b) {
+      if (b == body_ || world.model(b).is_static) continue;
+      const auto& m = world.model(b);
+      if ((world.center_of_mass(b) - region_pose.translation).norm() > m.bounding_radius + region_.bounding_radius) continue;
+      for (std::uint32_t g = m.first_geom; g < m.first_geom + m.geom_count; ++g) {
+        if (!contact::collide(region_, region_pose, world.geoms()[g].shape, world.geom_pose(g), 0.0, set_, scratch_)) continue;
+        for (int i = 0; i < set_.count; ++i) {
+          const double depth = -set_.points[std::size_t(i)].separation;
+          if (depth >= 0 && depth > best_depth) {
+            best_depth = depth;
+            best = b;
+          }
+        }
+      }
+    }
+    return best;
+  }
+
+  /// Before each world step: handles S transitions, applies the weld wrench, checks slip.
+  void pre_step(RigidWorld& world, double dt) {
+    grasped_now_ = released_now_ = slipped_ = false;
+    weld_force_.setZero();
+    weld_torque_.setZero();
+    elastic_force_ = 0;
+    if (command_ != state_) {
+      state_ = command_;
+      if (state_ == 1) {
+        if (auto b = find_graspable(world)) start_weld(world, *b, dt);
+      } else if (held_) {
+        release();
+      }
+    }
+    if (held_) apply_weld(world);
+  }
+
+ private:
+  void release() {
+    last_released_ = held_;
+    held_.reset();
+    released_now_ = true;
+  }
+
+  static double smallest_inertia(const RigidBodyModel& m) {
+    const Eigen::SelfAdjointEigenSolver<Mat3> eig(m.inertia);
+    return eig.eigenvalues().minCoeff();
+  }
+
+  void start_weld(RigidWorld& world, BodyId b, double dt) {
+    held_ = b;
+    grasped_now_ = true;
+    const Mat3 rg = world.orientation(body_).toRotationMatrix();
+    const Vec3 xg = world.position(body_);
+    const Vec3 xo = world.center_of_mass(b);
+    anchor_local_ = rg.transpose() * (xo - xg);
+    rotation_local_ = rg.transpose() * world.orientation(b).toRotationMatrix();
+    // Visible width: the object's extent along the closing axis inside the open fingers.
+    double lo = INFINITY, hi = -INFINITY;
+    const auto& m = world.model(b);
+    for (std::uint32_t g = m.first_geom; g < m.first_geom + m.geom_count; ++g) {
+      const contact::Pose gp = world.geom_pose(g);
+      contact::Pose local;
+      local.rotation = rg.transpose() * gp.rotation;
+      local.translation = rg.transpose() * (gp.translation - xg);
+      Vec3 glo, ghi;
+      world.geoms()[g].shape.bounds(local, glo, ghi);
+      lo = std::min(lo, glo.x());
+      hi = std::max(hi, ghi.x());
+    }
+    const double half = 0.5 * params_.open_width;
+    held_width_ = std::max(0.0, std::min(hi, half) - std::max(lo, -half));
+    // Stiffness caps on the pair's reduced mass and inertia (the force acts at x_o, a lever
+    // |x_o - x_g,com| on the gripper).
+    const auto& mg = world.model(body_);
+    const double lever2 = (xo - world.center_of_mass(body_)).squaredNorm();
+    const double inv_m = m.inverse_mass + mg.inverse_mass + lever2 * mg.inverse_inertia.norm();
+    const double inv_i = 1.0 / smallest_inertia(m) + 1.0 / smallest_inertia(mg);
+    const double w2 = (params_.max_omega_dt / dt) * (params_.max_omega_dt / dt);
+    k_ = std::min(params_.weld_stiffness, w2 / inv_m);
+    k_r_ = std::min(params_.weld_rotational_stiffness, w2 / inv_i);
+    c_ = 2 * params_.weld_damping_ratio * std::sqrt(k_ / inv_m);
+    c_r_ = 2 * params_.weld_damping_ratio * std::sqrt(k_r_ / inv_i);
+  }
+
+  void apply_weld(RigidWorld& world) {
+    const BodyId b = *held_;
+    const Mat3 rg = world.orientation(body_).toRotationMatrix();
+    const Vec3 xa = world.position(body_) + rg * anchor_local_;
+    const Vec3 xo = world.center_of_mass(b);
+    const Mat3 ra = rg * rotation_local_;
+    const Mat3 ro = world.orientation(b).toRotationMatrix();
+    const Vec3 dtheta = math::so3::log(Mat3(ro * ra.transpose()));  // lab axis
+    const Vec3 elastic = -k_ * (xo - xa);
+    const Vec3 elastic_torque = -k_r_ * dtheta;
+    elastic_force_ = elastic.norm();
+    if (elastic_force_ > params_.max_hold_force || elastic_torque.norm() > params_.max_hold_torque) {
+      slipped_ = true;
+      release();
+      return;
+    }
+    const Vec3 va = world.velocity_at_point(body_, xa);
+    weld_force_ = elastic - c_ * (world.linear_velocity(b) - va);
+    weld_torque_ = elastic_torque - c_r_ * (world.angular_velocity(b) - world.angular_velocity(body_));
+    world.add_force_and_torque(b, weld_force_, weld_torque_);
+    world.add_force_at_point(body_, -weld_force_, xo);
+    world.add_torque(body_, -weld_torque_);
+  }
+
+  ParallelGripperParameters params_;
+  contact::CollisionShape region_;
+  contact::ContactSet set_;
+  contact::NarrowPhaseScratch scratch_;
+  BodyId body_ = 0;
+  int command_ = 0, state_ = 0;
+  std::optional<BodyId> held_, last_released_;
+  double held_width_ = 0;
+  Vec3 anchor_local_ = Vec3::Zero();
+  Mat3 rotation_local_ = Mat3::Identity();
+  double k_ = 0, k_r_ = 0, c_ = 0, c_r_ = 0;
+  Vec3 weld_force_ = Vec3::Zero(), weld_torque_ = Vec3::Zero();
+  double elastic_force_ = 0;
+  bool grasped_now_ = false, released_now_ = false, slipped_ = false;
+};
+
+}  // namespace manisoft
