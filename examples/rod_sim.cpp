@@ -93,7 +93,6 @@ Options parse(int argc, char** argv) {
       const auto v = parse_list(flag, value(), 4);
       o.lab_torque = v[0];
       o.lab_axis = Eigen::Vector3d(v[1], v[2], v[3]);
-      if (o.lab_axis.norm() == 0) usage_error("--lab-torque axis must be non-zero");
     } else if (flag == "--follower-couple") {
       const auto v = parse_list(flag, value(), 3);
       o.follower = Eigen::Vector3d(v[0], v[1], v[2]);

@@ -2,8 +2,8 @@
 // applied forces (nodes, lab frame) and torques (elements, material frame), after the user's
 // own external loads, in the order PyElastica applies forcing (after the internal forces).
 //   Gravity              f_i += m_i g on every node (GravityForces).
-//   UniformLabTorque     tau_k += Q_k (T / n) u: a total torque T about a fixed lab axis u
-//                        spread over the elements (PyElastica UniformTorques).
+//   UniformLabTorque     tau_k += Q_k (T u) / n: a total torque T u about a fixed lab axis
+//                        spread over the elements (PyElastica UniformTorques; u is not normalized).
 //   ElementTorques       tau_k += the user's N x 3 material-frame torques (the paper's action).
 //   BsplineMuscleTorques tau_k(dir) += scale * spline_dir(s_k): Elastica-RL muscle torques;
 //                        N control points per direction (normal d1, binormal d2, twist d3) at
@@ -50,18 +50,15 @@ struct Gravity {
 template <typename Scalar>
 struct UniformLabTorque {
   Scalar torque = 0;                                    ///< T, total over the rod [N m]
-  Vector3<Scalar> direction = Vector3<Scalar>::UnitY();  ///< u (any length; its direction is used)
+  Vector3<Scalar> direction = Vector3<Scalar>::UnitY();  ///< u, used as given (not normalized, as PyElastica)
 
   void setup(const RodModel<Scalar>&) {
     manisoft::detail::require_finite("UniformLabTorque torque", torque);
     detail::require_finite_entries("UniformLabTorque direction", direction);
-    if (torque != 0 && direction.norm() == 0) manisoft::detail::fail("UniformLabTorque direction is zero");
   }
   void apply(const RodModel<Scalar>& model, const RodState<Scalar>& state, const RodWorkspace<Scalar>&,
              Array3<Scalar>&, Array3<Scalar>& torques) const {
-    const Scalar norm = direction.norm();
-    if (norm == 0) return;
-    const Vector3<Scalar> per_element = direction * (torque / (norm * Scalar(model.n_elements)));
+    const Vector3<Scalar> per_element = (direction * torque) / Scalar(model.n_elements);
     for (int i = 0; i < 3; ++i)
       torques.col(i) += state.directors.col(3 * i) * per_element[0] + state.directors.col(3 * i + 1) * per_element[1] +
                         state.directors.col(3 * i + 2) * per_element[2];
