@@ -203,3 +203,31 @@ TEST_CASE("the not-a-knot spline reproduces cubics and pins the muscle torque en
   for (int k = 0; k < 20; ++k)
     for (int d = 0; d < 3; ++d) CHECK(torques(k, d) == Approx(muscle.profile(d, (k + 1) / 20.0)).margin(1e-9));
 }
+
+TEST_CASE("float rods meet the same static solutions with float tolerances", "[rod][analytic][float]") {
+  const int n = 20;
+  const double L = 1;
+  SECTION("follower moment: uniform curvature M / EI") {
+    manisoft::forcing::TipLoad<float> tip;
+    tip.couple_material = {0, -float(youngs * second_moment), 0};  // radius of curvature 1 m
+    auto rod = settle<float>(n, 0.0f, tip, 4.0);
+    const auto& ws = rod.refresh();
+    for (int k = 0; k < n - 1; ++k) CHECK(ws.kappa(k, 1) == Approx(-1.0).epsilon(1e-3));
+  }
+  SECTION("tip torque: twist T (L - l0) / GJ") {
+    const double GJ = shear * 2 * second_moment, torque = 0.5 * GJ / L;
+    manisoft::forcing::TipLoad<float> tip;
+    tip.couple_material = {0, 0, float(torque)};
+    auto rod = settle<float>(n, 0.0f, tip, 3.0);
+    const Eigen::Matrix3f q = rod.state().director(n - 1);
+    const double twist = std::atan2(-q.row(0).dot(Eigen::Vector3f(0, -1, 0)), q.row(0).dot(Eigen::Vector3f::UnitZ()));
+    CHECK(std::abs(twist) == Approx(torque * L * (n - 1) / n / GJ).epsilon(1e-3));
+  }
+  SECTION("axial force: stretch F L / (EA - F)") {
+    const double force = 200, EA = youngs * area;
+    manisoft::forcing::TipLoad<float> tip;
+    tip.force_lab = {float(force), 0, 0};
+    auto rod = settle<float>(n, 0.0f, tip, 3.0);
+    CHECK(rod.tip_position().x() - 1.0 == Approx(force * L / (EA - force)).epsilon(2e-3));
+  }
+}
