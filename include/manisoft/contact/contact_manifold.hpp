@@ -25,6 +25,8 @@ struct ManifoldPoint {
   double separation{0}, relax_separation{0};
   double normal_mass{0};
   double relative_velocity{0};  ///< normal approach speed before the step (restitution)
+  // Jacobian rows and their images through the inverse inertia (no 3x3 products in iterations).
+  Vec3 ra_x_n{Vec3::Zero()}, rb_x_n{Vec3::Zero()}, ia_ra_x_n{Vec3::Zero()}, ib_rb_x_n{Vec3::Zero()};
 };
 
 /// Friction acts on the contact patch as a whole, at the centroid of its points: a 2D tangential
@@ -44,6 +46,9 @@ struct PatchFriction {
   Eigen::Vector2d drift_2d{Eigen::Vector2d::Zero()};
   double twist_mass{0}, twist_radius{0};
   bool sliding{false}, twisting{false};
+  std::array<Vec3, 2> ra_x_t{Vec3::Zero(), Vec3::Zero()}, rb_x_t{Vec3::Zero(), Vec3::Zero()};
+  std::array<Vec3, 2> ia_ra_x_t{Vec3::Zero(), Vec3::Zero()}, ib_rb_x_t{Vec3::Zero(), Vec3::Zero()};
+  Vec3 ia_n{Vec3::Zero()}, ib_n{Vec3::Zero()};
 };
 
 struct ContactManifold {

@@ -116,6 +116,10 @@ void prepare_contacts(std::vector<ContactManifold>& manifolds, const BodyStates&
       const Vec3 ran = p.ra.cross(n), rbn = p.rb.cross(n);
       const double kn = ba.inv_mass + bb.inv_mass + ran.dot(ba.inv_inertia * ran) + rbn.dot(bb.inv_inertia * rbn);
       p.normal_mass = kn > 0 ? 1.0 / kn : 0.0;
+      p.ra_x_n = ran;
+      p.rb_x_n = rbn;
+      p.ia_ra_x_n = ba.inv_inertia * ran;
+      p.ib_rb_x_n = bb.inv_inertia * rbn;
       p.relative_velocity = n.dot(detail::relative_velocity(ba, bb, p.ra, p.rb));
       p.max_normal_impulse = 0;
     }
@@ -129,7 +133,16 @@ void prepare_contacts(std::vector<ContactManifold>& manifolds, const BodyStates&
     f.twist_radius = m.count > 1 ? (2.0 / 3.0) * spread / m.count : 0.0;
     const Vec3 t[2] = {m.tangent1, m.tangent2};
     Vec3 rat[2], rbt[2];
-    for (int i = 0; i < 2; ++i) { rat[i] = f.ra.cross(t[i]); rbt[i] = f.rb.cross(t[i]); }
+    for (int i = 0; i < 2; ++i) {
+      rat[i] = f.ra.cross(t[i]);
+      rbt[i] = f.rb.cross(t[i]);
+      f.ra_x_t[static_cast<std::size_t>(i)] = rat[i];
+      f.rb_x_t[static_cast<std::size_t>(i)] = rbt[i];
+      f.ia_ra_x_t[static_cast<std::size_t>(i)] = ba.inv_inertia * rat[i];
+      f.ib_rb_x_t[static_cast<std::size_t>(i)] = bb.inv_inertia * rbt[i];
+    }
+    f.ia_n = ba.inv_inertia * n;
+    f.ib_n = bb.inv_inertia * n;
     for (int i = 0; i < 2; ++i) {
       for (int j = 0; j < 2; ++j) {
         f.tangent_k(i, j) = (i == j ? ba.inv_mass + bb.inv_mass : 0.0) + rat[i].dot(ba.inv_inertia * rat[j]) +
@@ -152,13 +165,19 @@ inline void warm_start_contacts(std::vector<ContactManifold>& manifolds, std::ve
     if (!m.active) continue;
     auto& ba = bodies[m.body_a];
     auto& bb = bodies[m.body_b];
+    double total = 0;
     for (int k = 0; k < m.count; ++k) {
       const auto& p = m.points[static_cast<std::size_t>(k)];
-      detail::apply_impulse(ba, bb, p.ra, p.rb, p.normal_impulse * m.normal);
+      total += p.normal_impulse;
+      ba.w -= p.normal_impulse * p.ia_ra_x_n;
+      bb.w += p.normal_impulse * p.ib_rb_x_n;
     }
     const auto& f = m.patch;
-    detail::apply_impulse(ba, bb, f.ra, f.rb, f.impulse[0] * m.tangent1 + f.impulse[1] * m.tangent2);
-    detail::apply_angular_impulse(ba, bb, f.twist_impulse * m.normal);
+    const Vec3 linear = total * m.normal + f.impulse[0] * m.tangent1 + f.impulse[1] * m.tangent2;
+    ba.v -= ba.inv_mass * linear;
+    bb.v += bb.inv_mass * linear;
+    ba.w -= f.impulse[0] * f.ia_ra_x_t[0] + f.impulse[1] * f.ia_ra_x_t[1] + f.twist_impulse * f.ia_n;
+    bb.w += f.impulse[0] * f.ib_rb_x_t[0] + f.impulse[1] * f.ib_rb_x_t[1] + f.twist_impulse * f.ib_n;
   }
 }
 
@@ -178,8 +197,9 @@ inline void solve_contacts(std::vector<ContactManifold>& manifolds, std::vector<
     const double max_friction = m.friction * total_normal;
     // Tangential friction at the centroid (Coulomb disc, anchored when sticking).
     {
-      const Vec3 dv = detail::relative_velocity(ba, bb, f.ra, f.rb);
-      const Eigen::Vector2d vt(m.tangent1.dot(dv), m.tangent2.dot(dv));
+      const Vec3 dv_lin = bb.v - ba.v;
+      const Eigen::Vector2d vt(m.tangent1.dot(dv_lin) + bb.w.dot(f.rb_x_t[0]) - ba.w.dot(f.ra_x_t[0]),
+                               m.tangent2.dot(dv_lin) + bb.w.dot(f.rb_x_t[1]) - ba.w.dot(f.ra_x_t[1]));
       Eigen::Vector2d d_lambda;
       if (use_bias) {
         d_lambda = -s.soft.mass_scale * (f.tangent_mass * (vt + s.soft.bias_rate * f.drift_2d)) - s.soft.impulse_scale * f.impulse;
@@ -204,7 +224,11 @@ inline void solve_contacts(std::vector<ContactManifold>& manifolds, std::vector<
       if (use_bias) f.sliding = clamped;
       d_lambda = lambda - f.impulse;
       f.impulse = lambda;
-      detail::apply_impulse(ba, bb, f.ra, f.rb, d_lambda[0] * m.tangent1 + d_lambda[1] * m.tangent2);
+      const Vec3 linear = d_lambda[0] * m.tangent1 + d_lambda[1] * m.tangent2;
+      ba.v -= ba.inv_mass * linear;
+      bb.v += bb.inv_mass * linear;
+      ba.w -= d_lambda[0] * f.ia_ra_x_t[0] + d_lambda[1] * f.ia_ra_x_t[1];
+      bb.w += d_lambda[0] * f.ib_rb_x_t[0] + d_lambda[1] * f.ib_rb_x_t[1];
     }
     // Twist friction about the normal.
     if (f.twist_radius > 0) {
@@ -218,13 +242,14 @@ inline void solve_contacts(std::vector<ContactManifold>& manifolds, std::vector<
       const double limit = max_friction * f.twist_radius;
       const double lambda = std::clamp(f.twist_impulse + d_lambda, -limit, limit);
       if (use_bias) f.twisting = std::abs(f.twist_impulse + d_lambda) > limit;
-      detail::apply_angular_impulse(ba, bb, (lambda - f.twist_impulse) * n);
+      ba.w -= (lambda - f.twist_impulse) * f.ia_n;
+      bb.w += (lambda - f.twist_impulse) * f.ib_n;
       f.twist_impulse = lambda;
     }
     // Non-penetration.
     for (int k = 0; k < m.count; ++k) {
       auto& p = m.points[static_cast<std::size_t>(k)];
-      const double vn = n.dot(detail::relative_velocity(ba, bb, p.ra, p.rb));
+      const double vn = n.dot(bb.v - ba.v) + bb.w.dot(p.rb_x_n) - ba.w.dot(p.ra_x_n);
       const double sep = use_bias ? p.separation : p.relax_separation;
       double bias = 0, mass_scale = 1, impulse_scale = 0;
       if (sep > 0) {
@@ -239,7 +264,10 @@ inline void solve_contacts(std::vector<ContactManifold>& manifolds, std::vector<
       const double applied = lambda - p.normal_impulse;
       p.normal_impulse = lambda;
       p.max_normal_impulse = std::max(p.max_normal_impulse, applied);
-      detail::apply_impulse(ba, bb, p.ra, p.rb, applied * n);
+      ba.v -= (ba.inv_mass * applied) * n;
+      ba.w -= applied * p.ia_ra_x_n;
+      bb.v += (bb.inv_mass * applied) * n;
+      bb.w += applied * p.ib_rb_x_n;
     }
   }
 }

@@ -31,8 +31,8 @@ struct RigidWorldSettings {
   double contact_hertz{0};           ///< soft contact stiffness; 0 = 0.125 / dt
   double contact_damping_ratio{10};  ///< Box2D v3's default (overdamped: no bounce from correction)
   double max_push_velocity{1.0};     ///< m/s: cap on penetration recovery speed
-  int solve_iterations{4};
-  int relax_iterations{2};
+  int solve_iterations{2};
+  int relax_iterations{1};
   double restitution_threshold{0.2};  ///< m/s: slower impacts are inelastic
   bool warm_start{true};
   bool enable_sleep{true};
@@ -555,12 +555,12 @@ class RigidWorld {
       Vec3 wb = s.rotation.transpose() * (b.w + h * (b.inv_inertia * s.torque));
       const Vec3 iw = m.inertia * wb;
       const Vec3 f = h * wb.cross(iw);
-      if (f.squaredNorm() > 0) {
+      if (h * wb.squaredNorm() > 1e-14) {  // negligible for bodies at rest
         Mat3 skew_w, skew_iw;
         skew_w << 0, -wb.z(), wb.y(), wb.z(), 0, -wb.x(), -wb.y(), wb.x(), 0;
         skew_iw << 0, -iw.z(), iw.y(), iw.z(), 0, -iw.x(), -iw.y(), iw.x(), 0;
         const Mat3 jac = m.inertia + h * (skew_w * m.inertia - skew_iw);
-        wb -= jac.partialPivLu().solve(f);
+        wb -= jac.inverse() * f;  // closed-form 3x3 inverse
       }
       b.w = s.rotation * wb;
     }
