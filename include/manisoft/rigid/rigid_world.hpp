@@ -10,7 +10,8 @@
 // Determinism: everything is iterated in body/geometry index order; broad-phase pairs are sorted.
 // Allocation: after the first steps (buffers grown to their working size) step() allocates only on
 // the FCL fallback path (sphere/capsule vs cylinder/mesh: FCL result vectors) and when the set of
-// overlapping pairs grows beyond its previous maximum.
+// overlapping pairs grows beyond its previous maximum (measured: no allocation in 10,000 steps of
+// each anchor scene S1-S6 after 2,000 warm-up steps; query_capsule allocates only on first use).
 #pragma once
 
 #include "manisoft/contact/contact_solver.hpp"
