@@ -48,8 +48,9 @@ namespace manisoft {
 
 struct ParallelGripperParameters {
   double palm_half_x = 0.06;       ///< m, along the closing axis
-  double palm_half_y = 0.04;       ///< m
-  double palm_thickness = 0.02;    ///< m, along the approach axis
+  double palm_half_y = 0.05;       ///< m
+  double palm_thickness = 0.05;    ///< m, along the approach axis (>= the rod radius: the tip's
+                                   ///< rounded end cap stays inside the palm)
   double finger_thickness = 0.01;  ///< m, along the closing axis
   double finger_half_width = 0.02; ///< m, along y
   double finger_length = 0.07;     ///< m, below the palm

@@ -1,0 +1,423 @@
+// world_demo: the ManiSoft tabletop world (issue 3): table, the soft arm mounted behind the table
+// (tabletop_scene.hpp), the parallel gripper and eight objects. It
+//   1. (--map) maps the reachable workspace over the table top for 9 candidate mounts (random
+//      bounded actuations settled to equilibrium) and prints the coverage table plus an ASCII map
+//      of the chosen mount (and writes it as a PGM image; WORLD_DEMO_MOUNT="h,pitch_deg" maps one),
+//   2. picks the grasp-capable equilibrium nearest the table's centre line, puts the target cube
+//      under it, and finds by Levenberg-Marquardt on arm equilibria (rod alone, the gripper as a
+//      tip load) the open-loop element torques that put the gripper above the cube, around it, at
+//      a drop-off point 15 cm closer to the base and down,
+//   3. runs the scripted sequence (torques ramped between those equilibria, S = 1 at the cube,
+//      S = 0 at the drop-off) in ArmWorld and writes the trace, one row per control step
+//      (7 substeps of 2e-4 s, 714 Hz).
+//
+// Usage: world_demo [--out world_trace.csv] [--map] [--map-pgm workspace.pgm] [--samples N]
+//
+// Trace schema (CSV, comma separated, one header row, then one row per control step; SI units,
+// lab frame, z up; quaternions w, x, y, z; the row is written after the control step's substeps):
+//   step                  control step index (0 = initial state, before any substep)
+//   time                  simulated time [s]
+//   S                     gripper command state (0 open, 1 closed)
+//   finger_width          visible distance between the fingers [m]: 0.10 open, the held object's
+//                         width along the closing axis when holding, 0 when closed on nothing
+//   held                  index of the held object in the object list below, -1 if none
+//   gripper_px..pz        gripper frame origin (centre of the palm's top face, where the rod
+//                         tip attaches) [m]
+//   gripper_qw..qz        gripper orientation (its z axis = approach direction, x = closing axis)
+//   node{i}_x..z          rod centreline, nodes i = 0 (base) .. 20 (tip) [m]
+//   {name}_px..pz         each object's shape-frame origin [m] (object list: cube, block,
+//   {name}_qw..qz         carton, can, bottle, ball, marker, bowl, in this column order)
+// Events (grasp, release, slip, objects leaving the table) are printed at the end.
+#include <Eigen/Core>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "manisoft/world/arm_world.hpp"
+#include "manisoft/world/tabletop_scene.hpp"
+
+namespace {
+
+using namespace manisoft;
+using Vec3 = Eigen::Vector3d;
+using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+constexpr double kDt = 2e-4;
+
+using SettleRod = CosseratRod<double, damping::UniformExp, bc::ClampedBase, integrator::PositionVerlet, forcing::Gravity,
+                              forcing::ElementTorques, forcing::TipLoad>;
+using Arm = CosseratRod<double, damping::AnalyticalLinear, bc::ClampedBase, integrator::PositionVerlet, forcing::Gravity,
+                        forcing::ElementTorques>;
+
+/// Arm equilibria under given element torques (rod only; the gripper as a tip load of its weight).
+class EquilibriumSolver {
+ public:
+  explicit EquilibriumSolver(const RodParameters<double>& rp, double gripper_mass, double grasp_offset)
+      : rod_(rp, kDt, damping::UniformExp<double>(20.0)), grasp_offset_(grasp_offset) {
+    forcing::TipLoad<double> tip;
+    tip.force_lab = Vec3(0, 0, -9.81 * gripper_mass);
+    rod_.forcing<forcing::TipLoad>() = tip;
+    start_ = rod_.state();
+  }
+  struct Result {
+    bool settled = false;
+    Vec3 grasp_center = Vec3::Zero();
+    Vec3 tool_axis = Vec3::Zero();  ///< d3 of the last element
+    double min_node_z = 0;
+  };
+  /// Settles from `from` (or the straight rod) under `torques`.
+  Result settle(const Array3& torques, const RodState<double>* from = nullptr) {
+    rod_.state() = from ? *from : start_;
+    rod_.forcing<forcing::ElementTorques>().set(torques);
+    Result r;
+    try {
+      for (int block = 0; block < 30; ++block) {  // at most 3 s
+        rod_.step(500);
+        const double speed = rod_.state().velocities.rowwise().norm().maxCoeff();
+        if (block >= 2 && speed < 2e-4) {
+          r.settled = true;
+          break;
+        }
+      }
+    } catch (const Error&) {
+      return r;
+    }
+    const int n = rod_.n_elements();
+    r.tool_axis = rod_.state().director(n - 1).row(2).transpose();
+    r.grasp_center = rod_.state().tip_position() + grasp_offset_ * r.tool_axis;
+    r.min_node_z = rod_.state().positions.col(2).minCoeff();
+    return r;
+  }
+  const RodState<double>& state() const { return rod_.state(); }
+  int n_elements() const { return rod_.n_elements(); }
+
+ private:
+  SettleRod rod_;
+  RodState<double> start_;
+  double grasp_offset_;
+};
+
+// ---- 1. actuations at equilibrium -----------------------------------------------------------------
+
+/// The actuation family the script uses: per bend axis c in {0, 1} a uniform couple a_c on
+/// elements 1..n-1 plus a tip couple t_c; parameters (a_0, t_0, a_1, t_1).
+Array3 family(const Eigen::Vector4d& p, int n) {
+  Array3 t = Array3::Zero(n, 3);
+  for (int k = 1; k < n; ++k) {
+    t(k, 0) = p[0];
+    t(k, 1) = p[2];
+  }
+  t(n - 1, 0) += p[1];
+  t(n - 1, 1) += p[3];
+  return t;
+}
+
+/// Levenberg-Marquardt (finite differences) on the equilibrium: grasp centre at `target`, tool
+/// axis straight down (weight 0.1 m per unit of axis error). Every evaluation settles from the
+/// equilibrium of the current parameters (warm start: small motions settle fast). Returns the
+/// parameters; `error` receives the final position error [m], `result` the equilibrium.
+Eigen::Vector4d solve_actuation(EquilibriumSolver& solver, const Vec3& target, Eigen::Vector4d p, double& error,
+                                EquilibriumSolver::Result& result, RodState<double>& state) {
+  const int n = solver.n_elements();
+  auto residual = [&](const EquilibriumSolver::Result& r) {
+    Eigen::Matrix<double, 6, 1> res;
+    res.head<3>() = r.grasp_center - target;
+    res.tail<3>() = 0.1 * (r.tool_axis - Vec3(0, 0, -1));
+    if (!r.settled) res *= 10;  // flutter: not an equilibrium
+    return res;
+  };
+  result = solver.settle(family(p, n), &state);
+  state = solver.state();
+  auto res = residual(result);
+  double lambda = 1e-2;
+  for (int it = 0; it < 12 && res.head<3>().norm() > 1e-3; ++it) {
+    Eigen::Matrix<double, 6, 4> jac;
+    for (int j = 0; j < 4; ++j) {
+      Eigen::Vector4d q = p;
+      const double h = j % 2 == 0 ? 0.05 : 0.2;
+      q[j] += h;
+      jac.col(j) = (residual(solver.settle(family(q, n), &state)) - res) / h;
+    }
+    bool improved = false;
+    for (int tries = 0; tries < 5 && !improved; ++tries) {
+      const Eigen::Matrix4d a = jac.transpose() * jac + lambda * Eigen::Matrix4d(jac.colwise().squaredNorm().asDiagonal());
+      const Eigen::Vector4d step = -a.ldlt().solve(jac.transpose() * res);
+      const auto trial = solver.settle(family(p + step, n), &state);
+      const auto trial_res = residual(trial);
+      if (trial_res.norm() < res.norm()) {
+        p += step;
+        res = trial_res;
+        result = trial;
+        state = solver.state();
+        lambda = std::max(1e-4, lambda * 0.3);
+        improved = true;
+      } else {
+        lambda *= 10;
+      }
+    }
+    if (!improved) break;
+  }
+  error = res.head<3>().norm();
+  return p;
+}
+
+// ---- 2. workspace map -----------------------------------------------------------------------
+
+struct MapResult {
+  int grid_x = 8, grid_y = 10;  ///< 10 cm cells over the 0.8 x 1.0 m top
+  std::vector<int> hits;        ///< grasp-capable equilibria per cell
+  int samples = 0, settled = 0, clear = 0;
+  int covered() const {
+    int c = 0;
+    for (int h : hits) c += h > 0;
+    return c;
+  }
+};
+
+
+/// A grasp-capable equilibrium found by the map.
+struct Sample {
+  Eigen::Vector4d p;
+  Vec3 grasp_center;
+  Vec3 tool_axis;
+};
+
+/// Random actuations of the script's family within the reach task's actuation limits (|tau| <=
+/// 150 N m bend per element; here at most 10 N m distributed and 150 N m at the tip in the
+/// vertical plane, 5 and 40 N m sideways), settled with the gripper's weight. A sample is
+/// grasp-capable when the arm (nodes, radius 5 cm) clears the top, the grasp centre is 2-20 cm
+/// above it and the tool axis within 45 degrees of straight down.
+MapResult map_workspace(const tabletop::ArmMount& mount, int samples, std::vector<Sample>* capable) {
+  const TableDesc table = tabletop::table();
+  const ParallelGripperParameters gp;
+  EquilibriumSolver solver(tabletop::arm_parameters(mount), gp.mass, gp.grasp_center().z());
+  MapResult m;
+  m.hits.assign(std::size_t(m.grid_x * m.grid_y), 0);
+  const double top = table.top_center.z();
+  std::mt19937_64 rng(2024);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < samples; ++i) {
+    const Eigen::Vector4d p(5 * u(rng), 40 * u(rng), 10 * u(rng), 150 * u(rng));
+    const auto r = solver.settle(family(p, solver.n_elements()));
+    ++m.samples;
+    if (!r.settled) continue;
+    ++m.settled;
+    if (r.min_node_z < top + 0.05) continue;
+    ++m.clear;
+    const Vec3 g = r.grasp_center;
+    if (g.z() < top + 0.02 || g.z() > top + 0.20 || -r.tool_axis.z() < std::cos(std::numbers::pi / 4)) continue;
+    const int ix = static_cast<int>(std::floor((g.x() - (table.top_center.x() - table.half_x)) / 0.1));
+    const int iy = static_cast<int>(std::floor((g.y() - (table.top_center.y() - table.half_y)) / 0.1));
+    if (ix < 0 || ix >= m.grid_x || iy < 0 || iy >= m.grid_y) continue;
+    ++m.hits[std::size_t(ix * m.grid_y + iy)];
+    if (capable) capable->push_back({p, g, r.tool_axis});
+  }
+  return m;
+}
+
+void print_map(const MapResult& m) {
+  std::printf("      y: -0.5 ............ +0.5\n");
+  for (int ix = m.grid_x - 1; ix >= 0; --ix) {
+    std::printf("x %.2f  ", 0.1 * ix + 0.05);
+    for (int iy = 0; iy < m.grid_y; ++iy) {
+      const int h = m.hits[std::size_t(ix * m.grid_y + iy)];
+      std::printf("%c", h == 0 ? '.' : (h < 3 ? 'o' : '#'));
+      std::printf(" ");
+    }
+    std::printf("\n");
+  }
+  std::printf("(rows: cell centre x [m] from the back edge, arm base at x = -0.05; '.' none, 'o' 1-2, '#' >= 3\n"
+              " grasp-capable equilibria per 10 cm cell)\n");
+}
+
+void write_pgm(const MapResult& m, const std::string& path) {
+  const int scale = 20;
+  std::ofstream out(path, std::ios::binary);
+  out << "P5\n" << m.grid_y * scale << " " << m.grid_x * scale << "\n255\n";
+  int peak = 1;
+  for (int h : m.hits) peak = std::max(peak, h);
+  for (int row = 0; row < m.grid_x * scale; ++row) {
+    const int ix = m.grid_x - 1 - row / scale;  // far edge of the table at the top of the image
+    for (int col = 0; col < m.grid_y * scale; ++col) {
+      const int h = m.hits[std::size_t(ix * m.grid_y + col / scale)];
+      out.put(static_cast<char>(h == 0 ? 0 : 80 + (175 * h) / peak));
+    }
+  }
+}
+
+// ---- 3. the scripted run --------------------------------------------------------------------
+
+struct Phase {
+  const char* name;
+  int target;       ///< index into the actuation list
+  double ramp;      ///< s to ramp from the previous torques
+  double hold;      ///< s to hold after the ramp
+  int s;            ///< gripper state during the phase
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string out_path = "world_trace.csv", pgm_path = "workspace.pgm";
+  bool do_map = false;
+  int samples = 300;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) {
+      out_path = argv[++i];
+    } else if (!std::strcmp(argv[i], "--samples") && i + 1 < argc) {
+      samples = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--map")) {
+      do_map = true;
+    } else if (!std::strcmp(argv[i], "--map-pgm") && i + 1 < argc) {
+      pgm_path = argv[++i];
+      do_map = true;
+    } else {
+      std::fprintf(stderr, "usage: world_demo [--out trace.csv] [--map] [--map-pgm workspace.pgm] [--samples N]\n");
+      return 2;
+    }
+  }
+  try {
+    const tabletop::ArmMount chosen;
+    if (do_map) {
+      std::printf("Reachable workspace over the table top: %d random bounded actuations per mount settled with the\n"
+                  "gripper's weight; a 10 cm cell counts when a grasp-capable pose (arm clear of the top, grasp centre\n"
+                  "2-20 cm above it, tool axis within 45 deg of straight down) lands in it.\n\n", samples);
+      std::printf("height above top [m]  pitch [deg]  settled  arm clear  grasp-capable cells (of 80)\n");
+      MapResult chosen_map;
+      std::vector<double> heights{0.45, 0.6, 0.75}, pitches{0.0, 30.0, 60.0};
+      if (const char* one = std::getenv("WORLD_DEMO_MOUNT")) {  // "height,pitch": map one mount only
+        heights = {std::atof(one)};
+        pitches = {std::atof(std::strchr(one, ',') + 1)};
+      }
+      for (double h : heights) {
+        for (double pitch_deg : pitches) {
+          tabletop::ArmMount m;
+          m.base_position.z() = tabletop::table().top_center.z() + h;
+          m.pitch = pitch_deg * std::numbers::pi / 180;
+          const MapResult r = map_workspace(m, samples, nullptr);
+          const bool is_chosen = std::abs(m.base_position.z() - chosen.base_position.z()) < 1e-9 && std::abs(m.pitch - chosen.pitch) < 1e-9;
+          std::printf("%20.2f  %11.0f  %7d  %9d  %19d%s\n", h, pitch_deg, r.settled, r.clear, r.covered(), is_chosen ? "   <- chosen" : "");
+          std::fflush(stdout);
+          if (is_chosen) chosen_map = r;
+        }
+      }
+      std::printf("\nChosen mount: base (%.2f, %.2f, %.2f), pitch %.0f deg down:\n", chosen.base_position.x(),
+                  chosen.base_position.y(), chosen.base_position.z(), chosen.pitch * 180 / std::numbers::pi);
+      print_map(chosen_map);
+      write_pgm(chosen_map, pgm_path);
+      std::printf("map image: %s\n\n", pgm_path.c_str());
+    }
+    // ---- the script's actuations (equilibria of the chosen mount)
+    std::vector<Sample> capable;
+    map_workspace(chosen, samples, &capable);
+    if (capable.empty()) detail::fail("no grasp-capable equilibrium found; raise --samples");
+    const Vec3 wish(0.5, 0.0, 0);
+    const Sample* best = &capable.front();
+    for (const auto& c : capable) {
+      const double score = (c.grasp_center - wish).head<2>().norm() - 0.2 * (-c.tool_axis.z());
+      const double best_score = (best->grasp_center - wish).head<2>().norm() - 0.2 * (-best->tool_axis.z());
+      if (score < best_score) best = &c;
+    }
+    const double top = tabletop::table().top_center.z();
+    const ParallelGripperParameters gp;
+    EquilibriumSolver solver(tabletop::arm_parameters(chosen), gp.mass, gp.grasp_center().z());
+    const Eigen::Vector2d target_xy = best->grasp_center.head<2>();
+    const Vec3 grasp_at(target_xy.x(), target_xy.y(), top + 0.045);  // fingertips 1 cm above the top
+    const Vec3 above = grasp_at + Vec3(0, 0, 0.12);
+    const Vec3 carry = grasp_at + Vec3(-0.15, 0.0, 0.14);
+    const Vec3 place = grasp_at + Vec3(-0.15, 0.0, 0.006);
+    std::vector<Eigen::Vector4d> actuations{Eigen::Vector4d::Zero()};
+    Eigen::Vector4d p = best->p;
+    for (const Vec3& target : {above, grasp_at, carry, place}) {
+      double error = 0;
+      EquilibriumSolver::Result r;
+      RodState<double> st = solver.state();
+      p = solve_actuation(solver, target, p, error, r, st);
+      std::printf("actuation for grasp centre (%.3f, %.3f, %.3f): a = (%.2f, %.2f) N m per element, tip (%.2f, %.2f) N m;"
+                  " equilibrium error %.1f mm, tool axis z %.3f\n", target.x(), target.y(), target.z(), p[0], p[2], p[1], p[3],
+                  error * 1e3, r.tool_axis.z());
+      actuations.push_back(p);
+    }
+    // actuations: 0 rest, 1 above, 2 grasp, 3 carry, 4 place
+    const std::vector<Phase> script{
+        {"approach", 1, 1.2, 0.6, 0}, {"descend", 2, 0.8, 0.5, 0}, {"close", 2, 0.0, 0.3, 1}, {"lift", 1, 0.6, 0.2, 1},
+        {"carry", 3, 0.8, 0.4, 1},    {"lower", 4, 0.6, 0.5, 1},   {"open", 4, 0.0, 0.3, 0}, {"retreat", 3, 0.6, 0.4, 0}};
+
+    // ---- the world
+    ArmWorldSettings settings;
+    ArmWorld<Arm> world(Arm(tabletop::arm_parameters(chosen), kDt, damping::AnalyticalLinear<double>(0.5)), settings);
+    const std::vector<BodyId> objects = tabletop::populate(world, target_xy);
+    const auto specs = tabletop::objects(top, target_xy);
+    std::ofstream trace(out_path);
+    if (!trace) detail::fail("cannot write the trace to '", out_path, "'");
+    trace.precision(7);
+    trace << "step,time,S,finger_width,held,gripper_px,gripper_py,gripper_pz,gripper_qw,gripper_qx,gripper_qy,gripper_qz";
+    const int n = world.rod().n_elements();
+    for (int i = 0; i <= n; ++i) trace << ",node" << i << "_x,node" << i << "_y,node" << i << "_z";
+    for (const auto& o : specs) {
+      const std::string nm = o.desc.name;
+      trace << "," << nm << "_px," << nm << "_py," << nm << "_pz," << nm << "_qw," << nm << "_qx," << nm << "_qy," << nm << "_qz";
+    }
+    trace << "\n";
+    long control_step = 0;
+    auto write_row = [&](int s) {
+      const auto& rigid = world.rigid();
+      const BodyId g = world.gripper_body();
+      int held = -1;
+      for (std::size_t i = 0; i < objects.size(); ++i) {
+        if (world.gripper().held() && *world.gripper().held() == objects[i]) held = static_cast<int>(i);
+      }
+      const Vec3 gx = rigid.position(g);
+      const auto gq = rigid.orientation(g);
+      trace << control_step << "," << world.time() << "," << s << "," << world.gripper().finger_width() << "," << held << ","
+            << gx.x() << "," << gx.y() << "," << gx.z() << "," << gq.w() << "," << gq.x() << "," << gq.y() << "," << gq.z();
+      const auto& st = world.rod().state();
+      for (int i = 0; i <= n; ++i) trace << "," << st.positions(i, 0) << "," << st.positions(i, 1) << "," << st.positions(i, 2);
+      for (const BodyId b : objects) {
+        const Vec3 x = rigid.position(b);
+        const auto q = rigid.orientation(b);
+        trace << "," << x.x() << "," << x.y() << "," << x.z() << "," << q.w() << "," << q.x() << "," << q.y() << "," << q.z();
+      }
+      trace << "\n";
+    };
+    write_row(0);
+    const double control_dt = kDt * settings.substeps_per_control_step;
+    Eigen::Vector4d current = actuations[0];
+    const Vec3 cube_start = world.rigid().position(objects[0]);
+    double max_weld = 0;
+    for (const auto& ph : script) {
+      const Eigen::Vector4d from = current, to = actuations[std::size_t(ph.target)];
+      const int ramp = static_cast<int>(std::lround(ph.ramp / control_dt)), hold = static_cast<int>(std::lround(ph.hold / control_dt));
+      for (int i = 0; i < ramp + hold; ++i) {
+        const double a = ramp > 0 ? std::min(1.0, double(i + 1) / ramp) : 1.0;
+        const double smooth = a * a * (3 - 2 * a);  // smoothstep: no torque jerk
+        current = from + smooth * (to - from);
+        world.control_step(family(current, n), ph.s);
+        ++control_step;
+        max_weld = std::max(max_weld, world.gripper().weld_elastic_force());
+        write_row(ph.s);
+      }
+      const Vec3 g = world.gripper().grasp_point(world.rigid());
+      std::printf("after %-8s t = %5.2f s: grasp centre (%.3f, %.3f, %.3f), S = %d, held = %s\n", ph.name, world.time(), g.x(), g.y(),
+                  g.z(), ph.s, world.gripper().held() ? world.rigid().model(*world.gripper().held()).name.c_str() : "-");
+    }
+    const Vec3 cube_end = world.rigid().position(objects[0]);
+    std::printf("\ncube moved from (%.3f, %.3f, %.3f) to (%.3f, %.3f, %.3f); largest weld force %.2f N\n", cube_start.x(),
+                cube_start.y(), cube_start.z(), cube_end.x(), cube_end.y(), cube_end.z(), max_weld);
+    for (const auto& e : world.events()) {
+      std::printf("event: t = %.4f s  %-14s %s\n", e.time, to_string(e.kind), e.name.c_str());
+    }
+    std::printf("trace: %s (%ld control steps)\n", out_path.c_str(), control_step + 1);
+  } catch (const Error& e) {
+    std::fprintf(stderr, "world_demo: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
