@@ -3,37 +3,13 @@
 // no heap memory once the rod is built, and runs are bit-identical for identical inputs.
 #include <catch2/catch.hpp>
 
-#include <atomic>
-#include <cstdlib>
+#include "../support/allocation_counter.hpp"
+
 #include <limits>
-#include <new>
 
 #include "manisoft/rod.hpp"
 
-// Counts global allocations so the no-allocation guarantee of step() is checked, not assumed.
-namespace {
-std::atomic<long> allocation_count{0};
-}
-void* counted_allocation(std::size_t size) noexcept {
-  ++allocation_count;
-  return std::malloc(size ? size : 1);
-}
-void* operator new(std::size_t size) {
-  if (void* p = counted_allocation(size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  if (void* p = counted_allocation(size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_allocation(size); }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_allocation(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+using manisoft_test::allocation_count;  // the no-allocation guarantee of step() is counted
 
 namespace {
 
