@@ -321,6 +321,13 @@ class RigidWorld {
     s.torque += torque;
     if (force.squaredNorm() > 0 || torque.squaredNorm() > 0) s.sleep_time = 0;
   }
+  /// Drops every force and torque added for the next step (e.g. after a coupled step failed).
+  void clear_external_loads() {
+    for (auto& s : states_) {
+      s.force.setZero();
+      s.torque.setZero();
+    }
+  }
   void set_velocity(BodyId id, const Vec3& linear, const Vec3& angular) {
     check_id(id);
     if (!linear.allFinite() || !angular.allFinite()) ::manisoft::detail::fail("rigid body ", id, describe(id), ": velocity is not finite");

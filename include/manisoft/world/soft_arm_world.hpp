@@ -14,7 +14,8 @@
 //   2. rod contact loads (policy),
 //   3. rod step (PositionVerlet etc.), then +wrench on the end-effector and the rigid step.
 // A failure (non-finite or diverging state) throws manisoft::Error naming the step and the rod
-// element or body; both subsystems then keep the state from before the step.
+// element or body; both subsystems then keep the state from before the step, and the loads queued
+// for the failed step are dropped.
 // Bodies that leave the workspace box are reported by `outside_workspace()`, never a crash.
 #pragma once
 
@@ -84,6 +85,7 @@ class SoftArmWorld {
       rod_.step();
     } catch (const Error& e) {
       rod_.state() = rod_backup_;
+      rigid_.clear_external_loads();  // nothing of the failed step stays queued
       detail::fail("SoftArmWorld step ", step_count_, ": rod: ", e.what());
     }
     try {
@@ -92,6 +94,7 @@ class SoftArmWorld {
       rigid_.step(rod_.dt());
     } catch (const Error& e) {
       rod_.state() = rod_backup_;
+      rigid_.clear_external_loads();
       detail::fail("SoftArmWorld step ", step_count_, ": rigid bodies: ", e.what());
     }
     ++step_count_;
