@@ -85,6 +85,43 @@ TEST_CASE("inverse statics warm start re-solves a nearby target in few iteration
   CHECK(r.iterations < 20);
 }
 
+TEST_CASE("inverse statics model estimates shift the feed-forward to the corrected model", "[executor][statics]") {
+  const auto params = manisoft::RodParameters<double>{};
+  control::InverseStatics<double> statics(control::make_arm_model(params, 0.2), {}, {150, 75});
+  REQUIRE(statics.solve_cold(table_pose()).within_limits);
+  const Array3 nominal = statics.feedforward();
+  // A 10% stiffer arm carrying 0.5 kg: its internal torque at the desired shape.
+  auto stiffer = params;
+  stiffer.youngs_modulus *= 1.1;
+  stiffer.shear_modulus = params.shear_modulus > 0 ? params.shear_modulus * 1.1 : 0;
+  const auto stiff_model = control::make_arm_model(stiffer, 0.5);
+  control::InverseStatics<double> reference(stiff_model, {}, {150, 75});
+  reference.set_coefficients(statics.coefficients());  // same curvature; shear stretch of the stiffer arm
+  statics.set_model_estimates(1.1, 0.5);
+  CHECK(statics.stiffness_scale() == 1.1);
+  CHECK(statics.payload_estimate() == 0.5);
+  const double scale = reference.feedforward().cwiseAbs().maxCoeff();
+  const double diff = (statics.feedforward() - reference.feedforward()).cwiseAbs().maxCoeff();
+  CAPTURE(scale, diff);
+  CHECK(diff < 2e-3 * scale);
+  CHECK((nominal - statics.feedforward()).cwiseAbs().maxCoeff() > 0.05 * scale);
+  statics.set_model_estimates(1.0, 0.2);
+  CHECK((nominal - statics.feedforward()).cwiseAbs().maxCoeff() < 1e-12 * scale);
+  CHECK_THROWS_AS(statics.set_model_estimates(0.0, 0.2), manisoft::Error);
+  CHECK_THROWS_AS(statics.set_model_estimates(1.0, -1.0), manisoft::Error);
+}
+
+TEST_CASE("cold inverse statics solves table targets within the limits on a bounded budget", "[executor][statics]") {
+  manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> env({}, manisoft::damping::AnalyticalLinear<double>(0.1));
+  control::InverseStatics<double> statics(env.nominal_model(), {}, env.config().limits);
+  for (std::uint64_t seed : {5u, 6u, 7u, 8u}) {
+    const auto r = statics.solve_cold(env.draw_target(seed));
+    CAPTURE(seed, r.max_torque_ratio, r.lm_iterations);
+    CHECK(r.within_limits);
+    CHECK(r.position_error < 1e-9);
+  }
+}
+
 TEST_CASE("bad targets are refused", "[executor][input]") {
   const auto model = control::make_arm_model(manisoft::RodParameters<double>{}, 0.2);
   control::InverseStatics<double> statics(model);
@@ -135,6 +172,31 @@ TEST_CASE("the model executor reaches and holds table targets", "[executor][reac
     CHECK(info.error.position_error < 0.01);
     CHECK(info.error.rotation_error < 0.1);
   }
+}
+
+TEST_CASE("the model executor estimates a stiffness error and reaches the target", "[executor][reach]") {
+  manisoft::env::ReachEnvConfig config;
+  config.model_error = 0.1;  // the simulated arm is 10% stiffer than the model
+  manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> env(config, manisoft::damping::AnalyticalLinear<double>(0.1));
+  control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits);
+  Array3 action = Array3::Zero(env.n_elements(), 3);
+  const auto* observation = &env.reset(4);
+  executor.reset();
+  manisoft::env::ReachInfo info;
+  for (int t = 0; t < env.config().horizon; ++t) {
+    executor.act(*observation, action);
+    const auto result = env.step(action);
+    observation = &result.observation;
+    info = result.info;
+    if (result.done) break;
+  }
+  CAPTURE(info.error.position_error, info.error.rotation_error, executor.statics().stiffness_scale());
+  CHECK(info.success);
+  CHECK(info.error.position_error < 0.01);
+  CHECK(info.error.rotation_error < 0.1);
+  CHECK(std::abs(executor.statics().stiffness_scale() - 1.1) < 0.03);
+  executor.reset();
+  CHECK(executor.statics().stiffness_scale() == 1.0);
 }
 
 TEST_CASE("MLP reproduces hand-computed outputs", "[executor][mlp]") {

@@ -1,26 +1,51 @@
 // Model-based executor (issue 4 part 4; DESIGN.md section 8): inverse statics feed-forward, node
-// velocity damping mapped to element torques, and an outer loop on the measured end-effector pose.
+// velocity and position feedback mapped to element torques, an online estimate of the arm's
+// stiffness scale, and an outer loop on the measured end-effector pose.
 //
 // Model it assumes (ArmModel): a uniform clamped Cosserat rod with known rest geometry,
 // density and Young's/shear moduli, uniform gravity, and a known point payload on the tip node
 // (the gripper); the end-effector frame is the tip frame (last node, last element's directors).
-// Anything else (a stiffness error, an unknown held load, the damping of the simulated rod) is
-// left to the feedback.
+// A stiffness error is estimated online (below); anything else (an unknown held load, the
+// damping of the simulated rod) is left to the feedback and the outer loop.
 //
-// Per control step, action = clamp(tau_ff + tau_damp), element 0 (clamped) = 0:
-//   tau_ff    the inverse statics feed-forward of the current shape target (inverse_statics.hpp);
-//   tau_damp  node forces F_j = -kd m_j v_j (velocities of unobserved nodes interpolated linearly
-//             between observed ones; the tip node carries the payload mass too) turned into the
-//             statically equivalent element couples. A set of couples m_i is equivalent to node
-//             forces F_j when it gives the same moment at every cross-section:
+// Per control step, action = clamp(tau_ff + tau_fb), element 0 (clamped) = 0:
+//   tau_ff    the inverse statics feed-forward of the current shape target (inverse_statics.hpp),
+//             with the elastic part scaled by the stiffness estimate s_hat;
+//   tau_fb    node forces F_j = -m_j (kd v_j + kp (x_j - x*_j)) (positions and velocities of
+//             unobserved nodes interpolated linearly between observed ones; the tip node carries
+//             the payload mass too) turned into the statically equivalent element couples. A set
+//             of couples m_i is equivalent to node forces F_j when it gives the same moment at
+//             every cross-section:
 //               m_k = (x_{k+1} - x_k) x sum_{j > k} F_j        (lab; to material with Q_k),
-//             the same lever-arm form as the rod's own shear couple (Q t x n) l0.
-//   outer loop every `outer_period` control steps: with the pose error averaged over the period,
-//             e_p = p* - p, e_R = log(R* R^T) (lab), the shape target moves by
-//               p_s <- p_s + K e_p,   R_s <- Exp(K e_R) R_s,
-//             and the inverse statics is re-solved (warm started) for the shifted target. This is
-//             integral action on the SE(3) tip error: it removes static errors from model errors
-//             (Young's modulus, unknown loads). K and the period set its speed.
+//             the same lever-arm form as the rod's own shear couple (Q t x n) l0. Q_k is the
+//             desired director turned by the smallest rotation taking the desired element
+//             tangent onto the observed one. The position term matters beyond steady-state
+//             accuracy: the feed-forward torques are follower (material-frame) loads, and on
+//             strongly curled shapes the equilibrium they hold flutters unless the feedback is
+//             stiff enough (measured: kp = 200 /s^2 lost 2-3% of table targets to growing
+//             oscillations, 800 none; kd = 35 /s).
+//   twist     the position feedback cannot see twist: a twist couple -k_tw phi (s_k / L) on every
+//             element, phi the twist of the observed end-effector frame about the tip tangent
+//             relative to the estimated tip frame, holds the twist of curled shapes (measured:
+//             without it some strongly curled table targets slowly twisted off to another
+//             equilibrium branch; k_tw = 20 N m/rad).
+//   ramp      a new target's shape is reached through the coefficient blend of the old and new
+//             inverse statics solutions (smoothstep) over max(ramp_steps, tip path / ramp_max_speed)
+//             control steps (at most max_ramp_steps): a blend whose tip sweeps a long path
+//             (measured up to 3.2 m for a 1 m arm) is slowed so the arm can follow it.
+//   stiffness estimate (after the ramp, while every observed node is slower than
+//             estimate_speed_gate): a stiffness error s/s_hat bends the arm, to first order, to
+//             the curvature (s_hat/s) c* of the desired one. Every `outer_period` steps the
+//             observed node deviations (and the tip rotation deviation) averaged over the period
+//             are regressed on the shape change of a relative curvature scaling, beta, and
+//             s_hat <- s_hat (1 - g beta). With the right s_hat the desired shape is again an exact
+//             equilibrium of the arm (measured: Young's modulus +-10% leaves no static error).
+//   outer loop every `outer_period` control steps while quasi-static: with the pose error
+//             averaged over the period, e_p = p* - p, e_R = log(R* R^T) (lab), the shape target
+//             moves by  p_s <- p_s + K e_p,  R_s <- Exp(K e_R) R_s,  and the inverse statics is
+//             re-solved (warm started) for the shifted target: integral action on the SE(3) tip
+//             error for what the stiffness estimate does not explain (an unknown load).
+// Only the observation is used: target, node positions/velocities, the end-effector pose.
 // No heap allocation in act() after the first call for a target; the inverse statics set-up of a
 // new target runs inside that call.
 #pragma once
@@ -38,14 +63,24 @@ namespace manisoft::control {
 
 template <typename Scalar>
 struct ModelExecutorSettings {
-  Scalar damping_gain = Scalar(25);        ///< kd, 1/s
-  Scalar position_gain = Scalar(200);     ///< kp, 1/s^2: node force -kp m (x - x_desired), same mapping
+  Scalar damping_gain = Scalar(35);        ///< kd, 1/s: node force -kd m v
+  Scalar position_gain = Scalar(800);      ///< kp, 1/s^2: node force -kp m (x - x_desired), same mapping
   Scalar outer_gain = Scalar(0.1);         ///< K per outer update (0 disables the outer loop)
-  int outer_period = 20;                   ///< control steps between outer updates
+  int outer_period = 20;                   ///< control steps between outer (and estimate) updates
   int outer_delay = 60;                    ///< control steps after the ramp before the first outer update
-  int ramp_steps = 250;                    ///< control steps of the shape ramp to a new target
+  int ramp_steps = 250;                    ///< control steps of the shape ramp to a new target (minimum)
+  int max_ramp_steps = 800;                ///< longest ramp
+  Scalar ramp_max_speed = Scalar(0.006);   ///< m per control step: mean tip speed along the ramp's path
   Scalar outer_speed_gate = Scalar(0.15);  ///< m/s: integrate only while every observed node is slower
   Scalar outer_max_shift = Scalar(0.3);    ///< bound on |p_s - p*| (m) and |log(R_s R*^T)| (rad)
+  Scalar stiffness_gain = Scalar(1);       ///< g of the stiffness-scale estimate (0: off)
+  int estimate_delay = 20;                 ///< control steps after the ramp before estimating
+  Scalar estimate_speed_gate = Scalar(1);  ///< m/s: estimate only while every observed node is slower
+  Scalar min_stiffness_scale = Scalar(0.5);  ///< bounds of s_hat
+  Scalar max_stiffness_scale = Scalar(2);
+  Scalar twist_gain = Scalar(20);          ///< N m/rad: twist couple -k phi_tip (s_k / L) on the tip twist error
+  Scalar twist_damping = Scalar(0);        ///< N m s/rad: twist couple -c w_tip (s_k / L) from end-effector
+                                           ///< pose differences (measured: no gain, > 1 destabilizes)
 };
 
 template <typename ScalarType>
@@ -64,12 +99,23 @@ class ModelExecutor {
     detail::require_non_negative("ModelExecutor outer_gain", settings_.outer_gain);
     detail::require_non_negative("ModelExecutor position_gain", settings_.position_gain);
     if (settings_.ramp_steps < 0) detail::fail("ModelExecutor ramp_steps = ", settings_.ramp_steps, " must be >= 0");
+    if (settings_.max_ramp_steps < settings_.ramp_steps)
+      detail::fail("ModelExecutor max_ramp_steps = ", settings_.max_ramp_steps, " must be >= ramp_steps = ", settings_.ramp_steps);
+    detail::require_positive("ModelExecutor ramp_max_speed", settings_.ramp_max_speed);
     if (settings_.outer_period < 1) detail::fail("ModelExecutor outer_period = ", settings_.outer_period, " must be >= 1");
     if (settings_.outer_delay < 0) detail::fail("ModelExecutor outer_delay = ", settings_.outer_delay, " must be >= 0");
     detail::require_positive("ModelExecutor outer_max_shift", settings_.outer_max_shift);
+    detail::require_non_negative("ModelExecutor stiffness_gain", settings_.stiffness_gain);
+    detail::require_non_negative("ModelExecutor twist_damping", settings_.twist_damping);
+    detail::require_non_negative("ModelExecutor twist_gain", settings_.twist_gain);
+    if (settings_.estimate_delay < 0) detail::fail("ModelExecutor estimate_delay = ", settings_.estimate_delay, " must be >= 0");
+    if (!(settings_.min_stiffness_scale > 0) || !(settings_.max_stiffness_scale >= settings_.min_stiffness_scale) ||
+        !std::isfinite(settings_.max_stiffness_scale))
+      detail::fail("ModelExecutor stiffness scale bounds [", settings_.min_stiffness_scale, ", ", settings_.max_stiffness_scale, "] are invalid");
     const int n = statics_.n_elements();
     positions_.setZero(n + 1, 3);
     velocities_.setZero(n + 1, 3);
+    direction_.setZero(n + 1, 3);
     node_mass_ = statics_.model().rod.node_masses;
     node_mass_[n] += statics_.model().payload_mass;
   }
@@ -77,8 +123,11 @@ class ModelExecutor {
   /// Forgets the target; the arm is assumed straight at rest (the shape ramp starts there).
   void reset() {
     has_target_ = false;
+    has_previous_ = false;
     steps_ = 0;
+    statics_.set_model_estimates(Scalar(1), statics_.model().payload_mass);
     statics_.set_coefficients(InverseStatics<Scalar>::Coefficients::Zero());
+    adapt_count_ = 0;
   }
 
   void act(const Observation<Scalar>& o, Array3& action) {
@@ -87,19 +136,31 @@ class ModelExecutor {
     if (action.rows() != n) action.resize(n, 3);  // allocates only if the caller passed a wrong size
     if (!has_target_ || !same_pose(o.target, target_)) set_target(o.target);
     interpolate(o);
-    if (steps_ < settings_.ramp_steps) {
+    if (steps_ < ramp_steps_) {
       // Quasi-static ramp: every intermediate shape is an exact equilibrium of the model.
-      const Scalar x = Scalar(steps_ + 1) / Scalar(settings_.ramp_steps);
+      const Scalar x = Scalar(steps_ + 1) / Scalar(ramp_steps_);
       const Scalar blend = x * x * (Scalar(3) - Scalar(2) * x);
       statics_.set_coefficients(ramp_start_ + blend * (ramp_end_ - ramp_start_));
     } else {
       outer_loop(o);
     }
+    // Twist rate at the tip from successive end-effector poses (lab angular velocity . d3).
+    Scalar tip_twist_rate = 0;
+    if (has_previous_ && o.time > previous_time_) {
+      const Vector3 w = math::so3::log(Matrix3(o.end_effector.rotation * previous_rotation_.transpose())) / (o.time - previous_time_);
+      if (w.allFinite()) tip_twist_rate = w.dot(o.end_effector.rotation.col(2));
+    }
+    previous_rotation_ = o.end_effector.rotation;
+    previous_time_ = o.time;
+    has_previous_ = true;
+    const bool adapting = settings_.stiffness_gain > Scalar(0) && steps_ >= ramp_steps_ + settings_.estimate_delay &&
+                          o.node_velocities.rowwise().norm().maxCoeff() <= settings_.estimate_speed_gate;
     // Velocity damping as element couples through the lever arms of the nodes beyond each element.
     const Array3& ff = statics_.feedforward();
     const RodState<Scalar>& desired = statics_.desired_state();
     const auto& limits = statics_.limits();
     Vector3 distal = Vector3::Zero();
+    Scalar tip_twist = 0;
     for (int k = n - 1; k >= 0; --k) {
       distal -= node_mass_[k + 1] * (settings_.damping_gain * velocities_.row(k + 1).transpose() +
                                      settings_.position_gain * (positions_.row(k + 1) - desired.positions.row(k + 1)).transpose());
@@ -108,13 +169,22 @@ class ModelExecutor {
       // rotation that takes the desired element tangent onto the observed one.
       const Vector3 desired_lever = (desired.positions.row(k + 1) - desired.positions.row(k)).transpose();
       const Matrix3 turn = Eigen::Quaternion<Scalar>::FromTwoVectors(desired_lever, lever).toRotationMatrix();
-      const Vector3 couple = desired.director(k) * (turn.transpose() * lever.cross(distal));
+      const Matrix3 frame = desired.director(k) * turn.transpose();  // lab -> estimated material
+      if (k == n - 1) {
+        // Twist of the observed tip frame about the tip tangent relative to the estimated one.
+        const Vector3 d = math::so3::log(Matrix3(o.end_effector.rotation * frame));
+        tip_twist = d.allFinite() ? d.dot(lever.normalized()) : Scalar(0);
+      }
+      Vector3 couple = frame * lever.cross(distal);
+      const Scalar share = (Scalar(k) + Scalar(0.5)) / Scalar(n);
+      couple[2] -= share * (settings_.twist_gain * tip_twist + settings_.twist_damping * tip_twist_rate);
       for (int i = 0; i < 3; ++i) {
         const Scalar lim = limits.limit(i);
         action(k, i) = std::clamp(ff(k, i) + couple[i], -lim, lim);
       }
     }
     action.row(0).setZero();
+    if (adapting) accumulate_estimate(o);
     ++steps_;
   }
 
@@ -127,10 +197,25 @@ class ModelExecutor {
     steps_ = 0;
     error_sum_.setZero();
     error_count_ = 0;
+    adapt_count_ = 0;
     ramp_start_ = statics_.coefficients();
     last_result_ = statics_.solve_cold(target);
     ramp_end_ = statics_.coefficients();
-    statics_.set_coefficients(settings_.ramp_steps > 0 ? ramp_start_ : ramp_end_);
+    // Ramp length: at least ramp_steps, longer when the blend's tip path (sampled) is long, so
+    // that the mean tip speed along it stays below ramp_max_speed.
+    ramp_path_ = 0;
+    if (settings_.ramp_steps > 0) {
+      Vector3 previous = statics_.tip_pose(ramp_start_).translation;
+      for (int i = 1; i <= ramp_samples; ++i) {
+        const Scalar x = Scalar(i) / Scalar(ramp_samples);
+        const Vector3 p = statics_.tip_pose(ramp_start_ + x * x * (Scalar(3) - Scalar(2) * x) * (ramp_end_ - ramp_start_)).translation;
+        ramp_path_ += (p - previous).norm();
+        previous = p;
+      }
+    }
+    const Scalar needed = ramp_path_ / settings_.ramp_max_speed;
+    ramp_steps_ = settings_.ramp_steps == 0 ? 0 : std::clamp(static_cast<int>(std::ceil(needed)), settings_.ramp_steps, settings_.max_ramp_steps);
+    statics_.set_coefficients(ramp_steps_ > 0 ? ramp_start_ : ramp_end_);
     return last_result_;
   }
 
@@ -138,6 +223,11 @@ class ModelExecutor {
   const InverseStaticsResult<Scalar>& last_statics_result() const { return last_result_; }
   const ModelExecutorSettings<Scalar>& settings() const { return settings_; }
   const Pose& shape_target() const { return shifted_; }
+  /// Control steps of the current target's shape ramp and the tip path length along it (m).
+  int ramp_length() const { return ramp_steps_; }
+  Scalar ramp_path() const { return ramp_path_; }
+  /// The stiffness scale the feed-forward currently assumes (1 = the model's).
+  Scalar stiffness_estimate() const { return statics_.stiffness_scale(); }
 
  private:
   static bool same_pose(const Pose& a, const Pose& b) {
@@ -163,8 +253,44 @@ class ModelExecutor {
     }
   }
 
+  /// Stiffness-scale estimate from the observed shape: with the arm quasi-static, the deviation
+  /// of the observed nodes (and the tip rotation) from the desired shape is regressed on the
+  /// shape change of a relative curvature scaling (InverseStatics::curvature_scale_direction);
+  /// a stiffer arm (s > s_hat) bends less (beta < 0), so s_hat <- s_hat (1 - gain beta).
+  void accumulate_estimate(const Observation<Scalar>& o) {
+    if (adapt_count_ == 0) {
+      statics_.curvature_scale_direction(direction_, direction_tip_);
+      adapt_num_ = adapt_den_ = 0;
+    }
+    const RodState<Scalar>& desired = statics_.desired_state();
+    Scalar num = 0, den = 0;
+    for (Eigen::Index i = 0; i < o.node_indices.size(); ++i) {
+      const int j = o.node_indices[i];
+      if (j == 0) continue;
+      const Vector3 u = direction_.row(j).transpose();
+      const Vector3 d = (o.node_positions.row(i) - desired.positions.row(j)).transpose();
+      num += u.dot(d);
+      den += u.dot(u);
+    }
+    const Scalar w = statics_.settings().rotation_weight;
+    const Matrix3 desired_tip = desired.director(statics_.n_elements() - 1).transpose();
+    const Vector3 dr = math::so3::log(Matrix3(o.end_effector.rotation * desired_tip.transpose()));
+    num += w * w * direction_tip_.dot(dr);
+    den += w * w * direction_tip_.squaredNorm();
+    if (!std::isfinite(num) || !std::isfinite(den)) return;
+    adapt_num_ += num;
+    adapt_den_ += den;
+    if (++adapt_count_ < settings_.outer_period) return;
+    adapt_count_ = 0;
+    if (!(adapt_den_ > Scalar(1e-12))) return;
+    const Scalar beta = std::clamp(adapt_num_ / adapt_den_, Scalar(-0.2), Scalar(0.2));
+    const Scalar s = std::clamp(statics_.stiffness_scale() * (Scalar(1) - settings_.stiffness_gain * beta), settings_.min_stiffness_scale,
+                                settings_.max_stiffness_scale);
+    statics_.set_model_estimates(s, statics_.payload_estimate());
+  }
+
   void outer_loop(const Observation<Scalar>& o) {
-    if (settings_.outer_gain == Scalar(0) || steps_ < settings_.ramp_steps + settings_.outer_delay) return;
+    if (settings_.outer_gain == Scalar(0) || steps_ < ramp_steps_ + settings_.outer_delay) return;
     Eigen::Matrix<Scalar, 6, 1> e;
     e.template head<3>() = target_.translation - o.end_effector.translation;
     e.template tail<3>() = math::so3::log(target_.rotation * o.end_effector.rotation.transpose());
@@ -203,11 +329,21 @@ class ModelExecutor {
   typename InverseStatics<Scalar>::Coefficients ramp_start_ = InverseStatics<Scalar>::Coefficients::Zero();
   typename InverseStatics<Scalar>::Coefficients ramp_end_ = InverseStatics<Scalar>::Coefficients::Zero();
   bool has_target_ = false;
+  static constexpr int ramp_samples = 24;
+  int ramp_steps_ = 0;
+  Scalar ramp_path_ = 0;
   long steps_ = 0;
   Array3 positions_, velocities_;
   Eigen::Matrix<Scalar, Eigen::Dynamic, 1> node_mass_;
   Eigen::Matrix<Scalar, 6, 1> error_sum_ = Eigen::Matrix<Scalar, 6, 1>::Zero();
   int error_count_ = 0;
+  Matrix3 previous_rotation_ = Matrix3::Identity();
+  Scalar previous_time_ = 0;
+  bool has_previous_ = false;
+  Array3 direction_;
+  Vector3 direction_tip_ = Vector3::Zero();
+  int adapt_count_ = 0;
+  Scalar adapt_num_ = 0, adapt_den_ = 0;
 };
 
 }  // namespace manisoft::control

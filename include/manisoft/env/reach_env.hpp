@@ -27,8 +27,13 @@
 //               x in [0.40, 0.85], y in [-0.25, 0.25], z in [-0.70, -0.30] m (table plane
 //               z = -0.75 m, the arm's base 0.75 m above it), tool axis d3 within 45 deg of -z
 //               (uniform on the cap), any yaw. Measured with the quadratic-curvature inverse
-//               statics: about 56% of such poses are reachable within the limits (x < 0.4 or
-//               x > 0.85 needs more tip torque; yaw does not matter much), the rest are redrawn.
+//               statics (2000 candidates): 50% are held within the limits and kept; the other
+//               half is redrawn: 21% have no shape at all (7.5% of the box lies beyond the 1 m
+//               arm's reach, |p| > 1 m, more is too close to full extension for the tip to point
+//               down), 29% need more torque than the limits. Acceptance by region: far and low
+//               (x > 0.70, z < -0.57) 7%, near (x < 0.55) 61-70%; tool tilt 0-15 deg 62%,
+//               30-45 deg 47%. Kept targets: tip axis bent 46-133 deg from the base axis (median
+//               85), total twist up to 244 deg (median 80), bend curvature up to 12 1/m.
 //   equilibria  tip poses where the arm settles under random bounded actuation: per axis a
 //               random quadratic torque profile along the arm (|tau| <= 10 N m bend,
 //               4 N m twist) plus a random tip-element couple (<= 60 N m bend, 20 N m twist),
