@@ -43,26 +43,27 @@ int main() {
   Rod rod(manisoft::RodParameters<double>{}, 2e-4, manisoft::damping::AnalyticalLinear<double>(0.1));
   auto& muscles = rod.forcing<manisoft::forcing::BsplineMuscleTorques>();
   // Two activation phases (6 control points x {normal, binormal, twist}, scale 75 N m):
-  // first curl the arm upwards, then reverse the distal half into an S shape.
-  Eigen::Matrix<double, 6, 3> curl = Eigen::Matrix<double, 6, 3>::Zero(), s_shape = curl;
+  // first curl the arm upwards, then reverse the activation so it swings and bends downwards.
+// Feed-forward torques alone leave the arm swinging (the executors in control/ add feedback).
+  Eigen::Matrix<double, 6, 3> curl = Eigen::Matrix<double, 6, 3>::Zero(), bend_down = curl;
   curl.col(1) << 0.16, 0.14, 0.12, 0.1, 0.08, 0.05;
-  s_shape.col(1) << 0.2, 0.16, 0.05, -0.1, -0.16, -0.12;
+  bend_down.col(1) << 0.2, 0.16, 0.05, -0.1, -0.16, -0.12;
   std::vector<std::pair<char, Eigen::MatrixX3d>> shapes{{'0', rod.state().positions}};
   std::printf("   t [s]    tip x     tip y     tip z   [m]   phase\n");
   const double control_dt = 7 * rod.dt();  // 714 Hz control, as in the paper
   for (int control_step = 0; control_step <= 2100; ++control_step) {
     const bool first = control_step < 1050;
-    if (control_step == 0 || control_step == 1050) muscles.set_control_points(first ? curl : s_shape);
+    if (control_step == 0 || control_step == 1050) muscles.set_control_points(first ? curl : bend_down);
     if (control_step % 150 == 0) {
       const auto tip = rod.tip_position();
-      std::printf("%8.3f %9.4f %9.4f %9.4f   %s\n", control_step * control_dt, tip.x(), tip.y(), tip.z(), first ? "curl" : "S-shape");
+      std::printf("%8.3f %9.4f %9.4f %9.4f   %s\n", control_step * control_dt, tip.x(), tip.y(), tip.z(), first ? "curl up" : "bend down");
     }
     if (control_step == 1049) shapes.emplace_back('1', rod.state().positions);
     if (control_step == 2100) shapes.emplace_back('2', rod.state().positions);
     rod.step(7);
   }
   draw(shapes);
-  std::printf("0: initial straight arm, 1: after %.1f s of 'curl', 2: after %.1f s more of 'S-shape'\n", 1050 * control_dt,
+  std::printf("0: initial straight arm, 1: after %.1f s of 'curl up', 2: after %.1f s more of 'bend down'\n", 1050 * control_dt,
               1050 * control_dt);
   return 0;
 }
