@@ -28,10 +28,9 @@
 // returned shape meets the target to ~1e-12 m. The Jacobian is analytic (below). Warm start:
 // solve() starts from the previous solution. Cold targets (solve_cold) start from the entries of
 // a start library whose tip poses are nearest the target (1500 deterministic random curvature
-// profiles within the actuation limits, built at construction, ~20 ms), then the previous
+// profiles within the actuation limits, built at construction, ~10 ms), then the previous
 // solution and the straight shape, on a budget of LM iterations over all starts; measured on
-// table targets: median ~0.55 ms, max ~1.7 ms CPU time per cold solve, every drawn target
-// solved within the limits.
+// table targets: mean ~0.45 ms, max ~1.5 ms CPU time per cold solve.
 // Model estimates (set_model_estimates): the feed-forward can assume a stiffness scale and a
 // payload other than the model's without re-solving the shape (used by the model executor).
 // No heap allocation after construction.

@@ -22,8 +22,9 @@
 //             tangent onto the observed one. The position term matters beyond steady-state
 //             accuracy: the feed-forward torques are follower (material-frame) loads, and on
 //             strongly curled shapes the equilibrium they hold flutters unless the feedback is
-//             stiff enough (measured: kp = 200 /s^2 lost 2-3% of table targets to growing
-//             oscillations, 800 none; kd = 35 /s).
+//             stiff enough (measured: kp = 200 /s^2, kd = 25 /s lost 2-3% of table targets to
+//             growing oscillations; kp = 800, kd = 35 with the twist term and the ramp below
+//             none on table seeds 1-6).
 //   twist     the position feedback cannot see twist: a twist couple -k_tw phi (s_k / L) on every
 //             element, phi the twist of the observed end-effector frame about the tip tangent
 //             relative to the estimated tip frame, holds the twist of curled shapes (measured:
@@ -34,7 +35,7 @@
 //             control steps (at most max_ramp_steps): a blend whose tip sweeps a long path
 //             (measured up to 3.2 m for a 1 m arm) is slowed so the arm can follow it.
 //   stiffness estimate (after the ramp, while every observed node is slower than
-//             estimate_speed_gate): a stiffness error s/s_hat bends the arm, to first order, to
+//             estimate_speed_gate and no actuator saturates): a stiffness error s/s_hat bends the arm, to first order, to
 //             the curvature (s_hat/s) c* of the desired one. Every `outer_period` steps the
 //             observed node deviations (and the tip rotation deviation) averaged over the period
 //             are regressed on the shape change of a relative curvature scaling, beta, and
@@ -80,7 +81,7 @@ struct ModelExecutorSettings {
   Scalar max_stiffness_scale = Scalar(2);
   Scalar twist_gain = Scalar(20);          ///< N m/rad: twist couple -k phi_tip (s_k / L) on the tip twist error
   Scalar twist_damping = Scalar(0);        ///< N m s/rad: twist couple -c w_tip (s_k / L) from end-effector
-                                           ///< pose differences (measured: no gain, > 1 destabilizes)
+                                           ///< pose differences (measured: no gain at 0.1-0.5, 2 destabilizes)
 };
 
 template <typename ScalarType>
@@ -161,6 +162,7 @@ class ModelExecutor {
     const auto& limits = statics_.limits();
     Vector3 distal = Vector3::Zero();
     Scalar tip_twist = 0;
+    bool saturated = false;
     for (int k = n - 1; k >= 0; --k) {
       distal -= node_mass_[k + 1] * (settings_.damping_gain * velocities_.row(k + 1).transpose() +
                                      settings_.position_gain * (positions_.row(k + 1) - desired.positions.row(k + 1)).transpose());
@@ -180,11 +182,14 @@ class ModelExecutor {
       couple[2] -= share * (settings_.twist_gain * tip_twist + settings_.twist_damping * tip_twist_rate);
       for (int i = 0; i < 3; ++i) {
         const Scalar lim = limits.limit(i);
-        action(k, i) = std::clamp(ff(k, i) + couple[i], -lim, lim);
+        const Scalar a = ff(k, i) + couple[i];
+        if (k > 0 && std::abs(a) > lim) saturated = true;
+        action(k, i) = std::clamp(a, -lim, lim);
       }
     }
     action.row(0).setZero();
-    if (adapting) accumulate_estimate(o);
+    // A saturated actuator does not apply the torque the estimate assumes: no update then.
+    if (adapting && !saturated) accumulate_estimate(o);
     ++steps_;
   }
 
