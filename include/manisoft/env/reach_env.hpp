@@ -6,8 +6,11 @@
 // Arm (paper "Key Parameters", DESIGN.md 3): n = 20, L = 1 m, r = 0.05 m, rho = 1000, E = 1e7,
 // G = E/3, base clamped at the origin with d3 = +x (horizontal), d1 = +z, gravity -z,
 // dt = 2e-4 s, PositionVerlet, 7 substeps per control step (714 Hz), horizon 1500 control steps.
-// End-effector: the tip frame (last node, last element's directors) carrying the gripper
-// (0.2 kg) plus an optional held load, modelled as a tip force m g (forcing::TipLoad).
+// End-effector: the full arm of the world issue: the parallel gripper (world/gripper.hpp, a rigid
+// compound body, 0.2 kg) on the elastic spring coupling (coupling/elastic_spring.hpp; see
+// ReachEnvConfig::coupling) to the rod tip, in a SoftArmWorld with gravity. The end-effector pose is the gripper's
+// attachment frame (the centre of the palm's top face, axes = the tip's directors when aligned).
+// A held load (`load_mass`) rides in the closed gripper: it is added to the gripper body's mass.
 // `model_error` F makes the simulated Young's modulus (1 + F) times the nominal one; the
 // nominal model (nominal_model()) is what an executor should assume: nominal E, gripper only.
 // Action: n x 3 material-frame element torques, clamped to the actuation limits
@@ -60,6 +63,8 @@
 #include "manisoft/reward/stability_reward.hpp"
 #include "manisoft/reward/sum.hpp"
 #include "manisoft/rod/cosserat_rod.hpp"
+#include "manisoft/world/gripper.hpp"
+#include "manisoft/world/soft_arm_world.hpp"
 
 namespace manisoft::env {
 
@@ -77,6 +82,16 @@ struct ReachEnvConfig {
   int substeps = 7;                         ///< simulation steps per control step (714 Hz)
   int horizon = 1500;                       ///< control steps per episode
   double gripper_mass = 0.2;                ///< kg, known to the executor's model
+  /// Rod tip <-> gripper spring. The stiff preset with a 10x stiffer rotational spring: the
+  /// executor drives the tip element with up to 150 N m, and with kM = 100 N m/rad a gripper
+  /// carrying a 0.3 kg load twisted 0.3 rad off the tip and the pair went unstable (reach_eval
+  /// --load-kg 0.3: 1-18 % success); with kM = 1000 it holds (omega dt = 0.4 on the tip element).
+  coupling::ElasticSpringParameters coupling = [] {
+    auto p = coupling::ElasticSpringParameters::stiff();
+    p.rotational_stiffness = 1000;
+    p.rotational_damping = 0.6;
+    return p;
+  }();
   double load_mass = 0;                     ///< kg, held load unknown to the model
   double model_error = 0;                   ///< F: simulated E = (1 + F) E_nominal
   int observe_stride = 2;                   ///< observe every k-th node (and the tip)
@@ -102,7 +117,8 @@ template <template <class> class Damping = damping::AnalyticalLinear>
 class ReachEnv {
  public:
   using Rod = CosseratRod<double, Damping, bc::ClampedBase, integrator::PositionVerlet, forcing::Gravity,
-                          forcing::ElementTorques, forcing::TipLoad>;
+                          forcing::ElementTorques>;
+  using World = SoftArmWorld<Rod>;
   using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
   using Pose = math::Pose<double>;
   using Reward = reward::Sum<reward::DistanceReward<double>, reward::StabilityReward<double>>;
@@ -121,7 +137,7 @@ class ReachEnv {
     detail::require_positive("dt", config_.dt);
     if (config_.substeps < 1) detail::fail("substeps = ", config_.substeps, " must be >= 1");
     if (config_.horizon < 1) detail::fail("horizon = ", config_.horizon, " must be >= 1");
-    detail::require_non_negative("gripper_mass", config_.gripper_mass);
+    detail::require_positive("gripper_mass", config_.gripper_mass);
     detail::require_non_negative("load_mass", config_.load_mass);
     if (!std::isfinite(config_.model_error) || config_.model_error <= -0.9)
       detail::fail("model_error = ", config_.model_error, " is invalid: it must be finite and > -0.9");
@@ -155,9 +171,10 @@ class ReachEnv {
     RodParameters<double> sim = config_.rod;
     sim.youngs_modulus *= 1 + config_.model_error;
     if (config_.rod.shear_modulus > 0) sim.shear_modulus *= 1 + config_.model_error;
-    forcing::TipLoad<double> tip;
-    tip.force_lab = forcing::Gravity<double>{}.acceleration * (config_.gripper_mass + config_.load_mass);
-    rod_.emplace(sim, config_.dt, damping_, forcing::Gravity<double>{}, forcing::ElementTorques<double>{}, tip);
+    ParallelGripperParameters gripper;
+    gripper.mass = config_.gripper_mass + config_.load_mass;
+    world_.emplace(Rod(sim, config_.dt, damping_), RigidWorldSettings{}, make_parallel_gripper(gripper),
+                   coupling::ElasticSpring(config_.coupling));
     reward_ = Reward{};
     info_ = ReachInfo{};
     held_ = 0;
@@ -168,7 +185,7 @@ class ReachEnv {
 
   /// Applies `action` (n x 3, clamped to the limits) for one control step.
   StepResult step(const Array3& action) {
-    if (!rod_) detail::fail("ReachEnv::step called before reset");
+    if (!world_) detail::fail("ReachEnv::step called before reset");
     const int n = n_elements();
     if (action.rows() != n || action.cols() != 3)
       detail::fail("ReachEnv::step expects an action of ", n, " x 3, got ", action.rows(), " x ", action.cols());
@@ -181,11 +198,11 @@ class ReachEnv {
         clipped_action_(k, c) = std::clamp(a, -lim, lim);
         if (k > 0 && std::abs(a) > lim) ++info_.clipped;
       }
-    rod_->template forcing<forcing::ElementTorques>().set(clipped_action_);
+    world_->rod().template forcing<forcing::ElementTorques>().set(clipped_action_);
     if (!info_.diverged) {
       try {
         for (int s = 0; s < config_.substeps; ++s) {
-          rod_->step();
+          world_->step();
           const double d = reward::pose_error(end_effector(), target_).distance;
           d_history_[d_count_ % config_.stability_window] = d;
           ++d_count_;
@@ -213,7 +230,8 @@ class ReachEnv {
 
   const Pose& target() const { return target_; }
   const ReachInfo& info() const { return info_; }
-  const Rod& rod() const { return *rod_; }
+  const Rod& rod() const { return world_->rod(); }
+  const World& world() const { return *world_; }
   /// Variance of d over the last stability_window simulation steps (fewer if not yet run).
   double stability_variance() const {
     const long m = std::min<long>(d_count_, config_.stability_window);
@@ -295,12 +313,12 @@ class ReachEnv {
   }
 
   Pose end_effector() const {
-    const auto& s = rod_->state();
-    return Pose{s.director(n_elements() - 1).transpose(), s.tip_position()};
+    const auto frame = world_->end_effector_frame();
+    return Pose{frame.rotation, frame.position};
   }
 
   void fill_observation() {
-    const auto& s = rod_->state();
+    const auto& s = world_->rod().state();
     observation_.target = target_;
     observation_.end_effector = end_effector();
     observation_.time = s.time;
@@ -314,7 +332,7 @@ class ReachEnv {
   Damping<double> damping_;
   control::ArmModel<double> nominal_;
   control::InverseStatics<double> statics_;
-  std::optional<Rod> rod_;
+  std::optional<World> world_;
   Reward reward_;
   Pose target_;
   control::Observation<double> observation_;
