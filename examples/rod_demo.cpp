@@ -1,5 +1,6 @@
 // rod_demo: the ManiSoft soft arm (1 m Cosserat rod, clamped at the origin pointing along +x,
-// gravity, PyElastica's analytical damping) driven by Elastica-RL style B-spline muscle torques.
+// gravity, PyElastica's analytical damping) driven by Elastica-RL style B-spline muscle torques
+// (an internal couple: element k gets T_k - T_{k+1}, see forcing.hpp).
 // Prints a side view (x-z plane) of the centreline at a few instants and the tip trajectory.
 #include <cmath>
 #include <cstdio>
@@ -42,12 +43,15 @@ void draw(const std::vector<std::pair<char, Eigen::MatrixX3d>>& shapes) {
 int main() {
   Rod rod(manisoft::RodParameters<double>{}, 2e-4, manisoft::damping::AnalyticalLinear<double>(0.1));
   auto& muscles = rod.forcing<manisoft::forcing::BsplineMuscleTorques>();
-  // Two activation phases (6 control points x {normal, binormal, twist}, scale 75 N m):
-  // first curl the arm upwards, then reverse the activation so it swings and bends downwards.
-// Feed-forward torques alone leave the arm swinging (the executors in control/ add feedback).
+  // Two activation phases (6 control points x {normal, binormal, twist}, scale 75 N m). The
+  // muscle is an internal couple: the cross-section near arc length s carries about 75 c(s) N m,
+  // against the bending stiffness EI = 49 N m^2 and a gravity moment of up to 38 N m at the base.
+  // A positive binormal couple curls the arm upwards: c ~ 1 near the base lifts it against gravity.
+  // Then a negative activation, about half as strong (gravity helps), bends it downwards.
+  // Feed-forward torques alone leave the arm swinging (the executors in control/ add feedback).
   Eigen::Matrix<double, 6, 3> curl = Eigen::Matrix<double, 6, 3>::Zero(), bend_down = curl;
-  curl.col(1) << 0.16, 0.14, 0.12, 0.1, 0.08, 0.05;
-  bend_down.col(1) << 0.2, 0.16, 0.05, -0.1, -0.16, -0.12;
+  curl.col(1) << 1.0, 1.0, 0.9, 0.8, 0.7, 0.5;
+  bend_down.col(1) << -0.2, -0.35, -0.5, -0.5, -0.4, -0.25;
   std::vector<std::pair<char, Eigen::MatrixX3d>> shapes{{'0', rod.state().positions}};
   std::printf("   t [s]    tip x     tip y     tip z   [m]   phase\n");
   const double control_dt = 7 * rod.dt();  // 714 Hz control, as in the paper

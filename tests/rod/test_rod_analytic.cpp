@@ -1,7 +1,8 @@
 // Cosserat rod against analytic solutions of beam theory, with measured convergence orders:
 // Timoshenko gravity sag, circular arc under a follower tip moment, axial stretch under a tip
 // force, twist under a tip torque, energy conservation without damping, PEFRL's order,
-// and the not-a-knot spline behind the B-spline muscle torques.
+// the not-a-knot spline behind the B-spline muscle torques, their difference rule (an internal
+// couple) and the curvature B kappa = T they hold at equilibrium.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -196,12 +197,72 @@ TEST_CASE("the not-a-knot spline reproduces cubics and pins the muscle torque en
   CHECK(muscle.profile(0, 3.0 / 7) == Approx(75.0).margin(1e-12));
   CHECK(muscle.profile(2, 5.0 / 7) == Approx(-37.5).margin(1e-12));
   CHECK(muscle.profile(1, 0.5) == Approx(0).margin(1e-12));
-  // The straight rod's element k ends at s = (k + 1) L / n: its torque is the profile there.
-  Eigen::Matrix<double, Eigen::Dynamic, 3> forces = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(21, 3);
-  Eigen::Matrix<double, Eigen::Dynamic, 3> torques = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(20, 3);
+  // Elastica-RL's difference rule: with T_k = profile(d, s_k) at the end s_k = (k + 1) L / n of
+  // element k of the straight rod, element k receives T_k - T_{k+1} (T_0 := 0, T_n := 0).
+  const int n = 20;
+  auto T = [&](int d, int k) { return k <= 0 || k >= n ? 0.0 : muscle.profile(d, (k + 1) / double(n)); };
+  Eigen::Matrix<double, Eigen::Dynamic, 3> forces = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(n + 1, 3);
+  Eigen::Matrix<double, Eigen::Dynamic, 3> torques = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(n, 3);
   muscle.apply(rod.model(), rod.state(), rod.refresh(), forces, torques);
-  for (int k = 0; k < 20; ++k)
-    for (int d = 0; d < 3; ++d) CHECK(torques(k, d) == Approx(muscle.profile(d, (k + 1) / 20.0)).margin(1e-9));
+  CHECK(forces.isZero(0.0));
+  CHECK(muscle.profile(0, 1.0 / n) != Approx(0).margin(1));  // T_0 is non-zero, yet unused
+  for (int d = 0; d < 3; ++d) {
+    CAPTURE(d);
+    for (int k = 0; k < n; ++k) {
+      CAPTURE(k);
+      CHECK(torques(k, d) == Approx(T(d, k) - T(d, k + 1)).margin(1e-9));
+      // Telescoping: the couple carried into element k from the tip side is T_k.
+      CHECK(torques.col(d).tail(n - k).sum() == Approx(T(d, k)).margin(1e-9));
+    }
+    // An internal couple: no net torque on the straight rod (angular momentum is conserved).
+    CHECK(torques.col(d).sum() == Approx(0).margin(1e-9));
+  }
+  // By hand at the ends: the last element gets T_{n-1} = profile(L) = 0 (pinned), the one before
+  // it T_{n-2} - 0, and the clamped element 0 gets -T_1.
+  CHECK(torques(n - 1, 0) == Approx(0).margin(1e-9));
+  CHECK(torques(n - 2, 0) == Approx(muscle.profile(0, 1.0 - 1.0 / n)).margin(1e-9));
+  CHECK(torques(0, 0) == Approx(-muscle.profile(0, 2.0 / n)).margin(1e-9));
+}
+
+TEST_CASE("muscle torques bend a weightless rod until B kappa balances the muscle couple", "[rod][bspline]") {
+  // Clamped, no gravity, heavily damped. The muscle applies no force, so at rest n = 0 (no shear,
+  // no stretch: e = eps = 1) and, with one bending direction, every director turns about the same
+  // axis d1: the d1 components of all element torques are in one frame and kappa x tau = 0.
+  // Element j's internal torque is then d_j - d_{j-1} with d_k = B kappa_k (internal_forces.hpp,
+  // Dh with zero ghosts), so balancing elements k+1..n-1 gives, exactly in the discrete scheme,
+  //   B kappa_k = sum_{j>k} tau_j(muscle) = T_{k+1} = profile(0, s_{k+1}),  s_{k+1} = (k + 2) L / n,
+  // at the Voronoi point k between elements k and k+1 (s = (k + 1) L / n).
+  using Rod = manisoft::CosseratRod<double, manisoft::damping::UniformExp, manisoft::bc::ClampedBase,
+                                    manisoft::integrator::PositionVerlet, manisoft::forcing::BsplineMuscleTorques>;
+  const int n = 20;
+  Rod rod(RodParameters<double>{}, 2e-4, manisoft::damping::UniformExp<double>(20.0));
+  auto& muscle = rod.forcing<manisoft::forcing::BsplineMuscleTorques>();
+  Eigen::Matrix<double, 6, 3> activation = Eigen::Matrix<double, 6, 3>::Zero();
+  activation.col(0) << 0.2, 0.1, -0.1, -0.2, 0.05, 0.2;  // normal direction only, |T| <~ 15 N m
+  muscle.set_control_points(activation);
+  // 4 s: the slowest mode (8.8 rad/s) decays like exp(-5.2 t) at gamma = 20/s, leaving a residual
+  // of order 0.3 exp(-21) ~ 1e-10 /m; the tolerance 1e-8 /m is still 1e6 below the lag test.
+  rod.step(20000);
+  const auto& ws = rod.refresh();
+  const double B = youngs * second_moment;  // E pi r^4 / 4 = 49.1 N m^2
+  REQUIRE(rod.model().bend_stiffness(0, 0) == Approx(B).epsilon(1e-12));
+  double max_kappa = 0, max_error = 0, max_lag = 0;
+  for (int k = 0; k < n - 1; ++k) {
+    const double expected = muscle.profile(0, (k + 2) / double(n)) / B;
+    CAPTURE(k, ws.kappa(k, 0), expected);
+    CHECK(ws.kappa(k, 0) == Approx(expected).margin(1e-8));
+    CHECK(std::abs(ws.kappa(k, 1)) < 1e-9);
+    CHECK(std::abs(ws.kappa(k, 2)) < 1e-9);
+    max_kappa = std::max(max_kappa, std::abs(expected));
+    max_error = std::max(max_error, std::abs(ws.kappa(k, 0) - expected));
+    // The profile at the Voronoi point itself differs by this much: the test sees the location.
+    max_lag = std::max(max_lag, std::abs(muscle.profile(0, (k + 1) / double(n)) / B - expected));
+  }
+  CAPTURE(max_kappa, max_error, max_lag);
+  CHECK(max_kappa > 0.2);  // a real, small deformation (|kappa| L ~ 0.3 rad)
+  CHECK(max_lag > 1e-2);   // far above the tolerance
+  CHECK(max_error < 1e-8);
+  CHECK(ws.kappa(n - 2, 0) == Approx(0).margin(1e-8));  // the pinned end: no couple at the tip
 }
 
 TEST_CASE("float rods meet the same static solutions with float tolerances", "[rod][analytic][float]") {

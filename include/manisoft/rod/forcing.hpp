@@ -5,10 +5,16 @@
 //   UniformLabTorque     tau_k += Q_k (T u) / n: a total torque T u about a fixed lab axis
 //                        spread over the elements (PyElastica UniformTorques; u is not normalized).
 //   ElementTorques       tau_k += the user's N x 3 material-frame torques (the paper's action).
-//   BsplineMuscleTorques tau_k(dir) += scale * spline_dir(s_k): Elastica-RL muscle torques;
-//                        N control points per direction (normal d1, binormal d2, twist d3) at
-//                        s = linspace(0, L, N + 2) with both end values pinned to 0, a cubic
-//                        not-a-knot spline, evaluated at s_k = sum_{j<=k} l_j (current lengths).
+//   BsplineMuscleTorques Elastica-RL muscle torques (MuscleTorquesWithVaryingBetaSplines):
+//                        T_k = scale * spline_dir(s_k) at s_k = sum_{j<=k} l_j (end of element
+//                        k, current lengths), applied as the difference
+//                          tau_k(dir) += T_k - T_{k+1}   (T_0 and T_n taken as 0),
+//                        i.e. +T_k on elements 1..n-1 and -T_{k+1} on elements 0..n-2. An
+//                        internal muscle couple: the torques sum to zero over the rod, and
+//                        sum_{j>=k} tau_j = T_k (k >= 1) is the couple carried across the start
+//                        of element k. N control points per direction (normal d1, binormal d2,
+//                        twist d3) at s = linspace(0, L, N + 2), end values pinned to 0, a
+//                        cubic not-a-knot spline.
 //   TipLoad              a force on the last node (lab), a couple on the last element given in
 //                        the material frame (follower) and/or in the lab frame.
 // Non-finite loads are refused when they are set, naming the element and component.
@@ -91,6 +97,16 @@ class ElementTorques {
   Array3<Scalar> torques_;
 };
 
+/// Elastica-RL's B-spline muscle torques (Case1 MuscleTorquesWithVaryingBetaSplines.apply_torques):
+/// per direction d, T_k = profile(d, s_k) at the end s_k = l_0 + ... + l_k of element k, and
+///   element 0:           -T_1
+///   element k (0<k<n-1): T_k - T_{k+1}
+///   element n-1:         T_{n-1}
+/// (numpy: external_torques[d, 1:] += T[1:]; external_torques[d, :-1] -= T[1:]). The muscle is
+/// internal: the element torques sum to zero, and by telescoping the couple carried across the
+/// cross-section between elements k-1 and k (the sum of the torques on elements k..n-1) is
+/// T_k = scale * spline_d(s_k), although that cross-section sits at s_k - l_k: the couple lags
+/// the spline by one element, as in Elastica-RL (T_0 is never used).
 template <typename Scalar>
 class BsplineMuscleTorques {
  public:
@@ -124,15 +140,20 @@ class BsplineMuscleTorques {
     }
   }
   const Array3<Scalar>& control_point_values() const { return activation_; }
-  /// The torque profile of direction d evaluated at arc length s.
+  /// The muscle couple profile scale * spline_d(s) of direction d at arc length s [N m].
   Scalar profile(int d, Scalar s) const { return scale * splines_[d](s); }
 
+  /// Adds T_k - T_{k+1} to element k, T_k = profile(d, s_k) at the current lengths (class comment).
   void apply(const RodModel<Scalar>& model, const RodState<Scalar>&, const RodWorkspace<Scalar>& ws, Array3<Scalar>&,
              Array3<Scalar>& torques) const {
-    Scalar s = 0;
-    for (int k = 0; k < model.n_elements; ++k) {
+    Scalar s = ws.lengths[0];  // s_0: T_0 acts on no element
+    for (int k = 1; k < model.n_elements; ++k) {
       s += ws.lengths[k];
-      for (int d = 0; d < 3; ++d) torques(k, d) += scale * splines_[d](s);
+      for (int d = 0; d < 3; ++d) {
+        const Scalar couple = profile(d, s);
+        torques(k, d) += couple;
+        torques(k - 1, d) -= couple;
+      }
     }
   }
 
