@@ -2,7 +2,8 @@
 //
 //   reach_eval --targets 100 --seed S --set table|equilibria --executor model|mlp
 //              [--weights FILE] [--load-kg M] [--model-error F] [--tol-pos M --tol-rot RAD]
-//              [--damping analytical|analytical:NU|uniform:GAMMA] --out FILE.csv
+//              [--damping analytical|analytical:NU|uniform:GAMMA] [--action elements|bspline[:K]|bspline-pinned[:K]]
+//              --out FILE.csv
 //
 // Every target runs the full horizon (1500 control steps). Success: the pose error is within
 // tolerance (|d_p| < tol-pos, |d_r| < tol-rot; defaults 0.03 m, 0.3 rad) and then stays within it
@@ -12,6 +13,11 @@
 // target. Set-up (the first act() of a target: the inverse statics solve) is reported in wall
 // time and in process CPU time (std::clock; on a shared machine the wall time includes waits for
 // the CPU). --damping picks the simulated rod's damping (default analytical:0.1, PyElastica's).
+// --action picks the action space (control/action_space.hpp): element torques (n x 3, default)
+// or K B-spline muscle control values per direction (default K = 8; bspline-pinned: K interior
+// control values with zero ends, Elastica-RL's layout). The model
+// executor drives the B-spline space through ProjectedExecutor (least-squares fit of its element
+// torques); an MLP's network must output rows x 3 values of the chosen space.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +29,7 @@
 
 #include "manisoft/control/mlp_executor.hpp"
 #include "manisoft/control/model_executor.hpp"
+#include "manisoft/control/projected_executor.hpp"
 #include "manisoft/env/reach_env.hpp"
 
 namespace {
@@ -30,7 +37,7 @@ namespace {
 struct Options {
   int targets = 100;
   long seed = 0;
-  std::string set = "table", executor = "model", weights, out, damping = "analytical:0.1";
+  std::string set = "table", executor = "model", weights, out, damping = "analytical:0.1", action = "elements";
   double load = 0, model_error = 0, tol_pos = 0.03, tol_rot = 0.3;
 };
 
@@ -38,7 +45,8 @@ struct Options {
   std::cerr << "reach_eval: " << message << "\n"
             << "usage: reach_eval --targets N --seed S --set table|equilibria --executor model|mlp\n"
                "                  [--weights FILE] [--load-kg M] [--model-error F] [--tol-pos M --tol-rot RAD]\n"
-               "                  [--damping analytical|analytical:NU|uniform:GAMMA] --out FILE.csv\n";
+               "                  [--damping analytical|analytical:NU|uniform:GAMMA] [--action elements|bspline[:K]|bspline-pinned[:K]]\n"
+               "                  --out FILE.csv\n";
   std::exit(2);
 }
 
@@ -75,6 +83,7 @@ Options parse(int argc, char** argv) {
     else if (flag == "--tol-pos") o.tol_pos = parse_number(flag, value());
     else if (flag == "--tol-rot") o.tol_rot = parse_number(flag, value());
     else if (flag == "--damping") o.damping = value();
+    else if (flag == "--action") o.action = value();
     else if (flag == "--out") o.out = value(), have_out = true;
     else usage_error("unknown option " + flag);
   }
@@ -88,9 +97,8 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-template <template <class> class Damping, typename Executor>
-int run(const Options& o, Damping<double> damping, Executor& executor, manisoft::env::ReachEnv<Damping>& env) {
-  (void)damping;
+template <typename Env, typename Executor>
+int run(const Options& o, Executor& executor, Env& env) {
   std::ofstream csv(o.out);
   if (!csv) {
     std::cerr << "reach_eval: cannot write " << o.out << "\n";
@@ -102,7 +110,7 @@ int run(const Options& o, Damping<double> damping, Executor& executor, manisoft:
   int successes = 0;
   double steps_sum = 0, variance_sum = 0, step_us_sum = 0, setup_us_sum = 0, setup_us_max = 0, setup_cpu_max = 0, setup_cpu_sum = 0;
   long step_count = 0;
-  Eigen::Matrix<double, Eigen::Dynamic, 3> action = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(env.n_elements(), 3);
+  Eigen::Matrix<double, Eigen::Dynamic, 3> action = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(env.action_space().rows(), 3);
   for (int i = 0; i < o.targets; ++i) {
     const auto* observation = &env.reset(static_cast<std::uint64_t>(o.seed) * 1000003ull + static_cast<std::uint64_t>(i));
     executor.reset();
@@ -156,21 +164,40 @@ int run(const Options& o, Damping<double> damping, Executor& executor, manisoft:
   return 0;
 }
 
-template <template <class> class Damping>
-int run_with(const Options& o, Damping<double> damping) {
+template <template <class> class Damping, template <class> class ActionPolicy>
+int run_with(const Options& o, Damping<double> damping, typename ActionPolicy<double>::Settings action_settings = {}) {
   manisoft::env::ReachEnvConfig config;
   config.target_set = manisoft::env::parse_target_set(o.set);
   config.load_mass = o.load;
   config.model_error = o.model_error;
   config.tolerance_position = o.tol_pos;
   config.tolerance_rotation = o.tol_rot;
-  manisoft::env::ReachEnv<Damping> env(config, damping);
+  manisoft::env::ReachEnv<Damping, ActionPolicy> env(config, damping, action_settings);
   if (o.executor == "model") {
-    manisoft::control::ModelExecutor<double> executor(env.nominal_model(), config.limits);
-    return run(o, damping, executor, env);
+    manisoft::control::ModelExecutor<double> model(env.nominal_model(), config.limits);
+    manisoft::control::ProjectedExecutor executor(std::move(model), env.action_space());
+    return run(o, executor, env);
   }
-  manisoft::control::MlpExecutor<double> executor(manisoft::control::Mlp<double>::load(o.weights), env.n_elements(), config.limits);
-  return run(o, damping, executor, env);
+  manisoft::control::MlpExecutor<double> executor(manisoft::control::Mlp<double>::load(o.weights), env.action_space().rows());
+  return run(o, executor, env);
+}
+
+template <template <class> class Damping>
+int run_with_action(const Options& o, Damping<double> damping) {
+  if (o.action == "elements") return run_with<Damping, manisoft::control::ElementTorqueAction>(o, damping);
+  for (const bool pinned : {true, false}) {
+    const std::string name = pinned ? "bspline-pinned" : "bspline";
+    if (o.action != name && o.action.rfind(name + ":", 0) != 0) continue;
+    manisoft::control::BsplineMuscleAction<double>::Settings settings;
+    settings.pinned_ends = pinned;
+    if (o.action.size() > name.size()) {
+      const double k = parse_number("--action", o.action.substr(name.size() + 1));
+      if (k != std::floor(k) || k < 1 || k > 1000) usage_error("--action " + name + ":K needs a positive integer K");
+      settings.control_points = static_cast<int>(k);
+    }
+    return run_with<Damping, manisoft::control::BsplineMuscleAction>(o, damping, settings);
+  }
+  usage_error("--action must be elements, bspline[:K] or bspline-pinned[:K]");
 }
 
 }  // namespace
@@ -182,8 +209,8 @@ int main(int argc, char** argv) {
     const auto colon = d.find(':');
     const std::string kind = d.substr(0, colon);
     const double value = colon == std::string::npos ? -1 : parse_number("--damping", d.substr(colon + 1));
-    if (kind == "analytical") return run_with<manisoft::damping::AnalyticalLinear>(o, manisoft::damping::AnalyticalLinear<double>(value < 0 ? 0.1 : value));
-    if (kind == "uniform") return run_with<manisoft::damping::UniformExp>(o, manisoft::damping::UniformExp<double>(value < 0 ? 1.0 : value));
+    if (kind == "analytical") return run_with_action(o, manisoft::damping::AnalyticalLinear<double>(value < 0 ? 0.1 : value));
+    if (kind == "uniform") return run_with_action(o, manisoft::damping::UniformExp<double>(value < 0 ? 1.0 : value));
     usage_error("--damping must be analytical[:NU] or uniform[:GAMMA]");
   } catch (const manisoft::Error& e) {
     std::cerr << "reach_eval: " << e.what() << "\n";

@@ -13,6 +13,7 @@
 #include "manisoft/control/inverse_statics.hpp"
 #include "manisoft/control/mlp_executor.hpp"
 #include "manisoft/control/model_executor.hpp"
+#include "manisoft/control/projected_executor.hpp"
 #include "manisoft/env/reach_env.hpp"
 #include "manisoft/rod.hpp"
 
@@ -34,6 +35,23 @@ Pose table_pose() {
   down << 1, 0, 0, 0, -1, 0, 0, 0, -1;
   return Pose{Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.6, 0.8, 0)).toRotationMatrix() * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix() * down,
               Eigen::Vector3d(0.62, 0.1, -0.5)};
+}
+
+/// Runs one episode of `env` from `seed` with `executor` and returns the final info.
+template <typename Env, typename Executor>
+manisoft::env::ReachInfo run_episode(Env& env, Executor& executor, std::uint64_t seed) {
+  Array3 action = Array3::Zero(env.action_space().rows(), 3);
+  const auto* observation = &env.reset(seed);
+  executor.reset();
+  manisoft::env::ReachInfo info;
+  for (int t = 0; t < env.config().horizon; ++t) {
+    executor.act(*observation, action);
+    const auto result = env.step(action);
+    observation = &result.observation;
+    info = result.info;
+    if (result.done) break;
+  }
+  return info;
 }
 
 std::string write_file(const std::string& name, const std::string& text) {
@@ -155,18 +173,8 @@ TEST_CASE("reach environment targets are deterministic per seed", "[executor][en
 TEST_CASE("the model executor reaches and holds table targets", "[executor][reach]") {
   manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> env({}, manisoft::damping::AnalyticalLinear<double>(0.1));
   control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits);
-  Array3 action = Array3::Zero(env.n_elements(), 3);
   for (std::uint64_t seed : {1u, 2u, 3u}) {
-    const auto* observation = &env.reset(seed);
-    executor.reset();
-    manisoft::env::ReachInfo info;
-    for (int t = 0; t < env.config().horizon; ++t) {
-      executor.act(*observation, action);
-      const auto result = env.step(action);
-      observation = &result.observation;
-      info = result.info;
-      if (result.done) break;
-    }
+    const auto info = run_episode(env, executor, seed);
     CAPTURE(seed, info.error.position_error, info.error.rotation_error);
     CHECK(info.success);
     CHECK(info.error.position_error < 0.01);
@@ -174,22 +182,28 @@ TEST_CASE("the model executor reaches and holds table targets", "[executor][reac
   }
 }
 
+TEST_CASE("the model executor drives B-spline muscle actions through their projection", "[executor][reach]") {
+  using Env = manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear, control::BsplineMuscleAction>;
+  Env env({}, manisoft::damping::AnalyticalLinear<double>(0.1), {6, false, 1});
+  REQUIRE(env.action_space().rows() == 6);
+  control::ProjectedExecutor executor(control::ModelExecutor<double>(env.nominal_model(), env.config().limits), env.action_space());
+  for (std::uint64_t seed : {1u, 2u}) {
+    const auto info = run_episode(env, executor, seed);
+    CAPTURE(seed, info.error.position_error, info.error.rotation_error);
+    CHECK(info.success);
+    CHECK(info.error.position_error < 0.01);
+    CHECK(info.error.rotation_error < 0.1);
+  }
+  // The action really is 6 x 3 control values: a malformed one is refused.
+  CHECK_THROWS_WITH(env.step(Array3::Zero(env.n_elements(), 3)), Catch::Contains("expects 6 x 3"));
+}
+
 TEST_CASE("the model executor estimates a stiffness error and reaches the target", "[executor][reach]") {
   manisoft::env::ReachEnvConfig config;
   config.model_error = 0.1;  // the simulated arm is 10% stiffer than the model
   manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> env(config, manisoft::damping::AnalyticalLinear<double>(0.1));
   control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits);
-  Array3 action = Array3::Zero(env.n_elements(), 3);
-  const auto* observation = &env.reset(4);
-  executor.reset();
-  manisoft::env::ReachInfo info;
-  for (int t = 0; t < env.config().horizon; ++t) {
-    executor.act(*observation, action);
-    const auto result = env.step(action);
-    observation = &result.observation;
-    info = result.info;
-    if (result.done) break;
-  }
+  const auto info = run_episode(env, executor, 4);
   CAPTURE(info.error.position_error, info.error.rotation_error, executor.statics().stiffness_scale());
   CHECK(info.success);
   CHECK(info.error.position_error < 0.01);
@@ -234,8 +248,8 @@ TEST_CASE("MLP reproduces hand-computed outputs", "[executor][mlp]") {
   CHECK(y2[1] == Approx(-3 * std::tanh(0.1)).epsilon(1e-14));
 }
 
-TEST_CASE("MLP executor maps features to clamped torques", "[executor][mlp]") {
-  // 24 + 6 * 2 = 36 features for 2 observed nodes; 3 elements -> 9 outputs; one linear layer
+TEST_CASE("MLP executor maps features to action rows", "[executor][mlp]") {
+  // 24 + 6 * 2 = 36 features for 2 observed nodes; 3 action rows -> 9 outputs; one linear layer
   // whose output k is 100 * feature k (feature 0 = target x).
   std::string text = "manisoft-mlp 1\nlayers 1\ninput 36\nlayer 9 linear\n";
   for (int i = 0; i < 9; ++i) {
@@ -243,7 +257,8 @@ TEST_CASE("MLP executor maps features to clamped torques", "[executor][mlp]") {
     text += "\n";
   }
   text += "0 0 0 0 0 0 0 0 1\n";
-  control::MlpExecutor<double> executor(control::Mlp<double>::load(write_file("mlp_exec.txt", text)), 3, {150, 75});
+  const std::string path = write_file("mlp_exec.txt", text);
+  control::MlpExecutor<double> executor(control::Mlp<double>::load(path), 3);
   control::Observation<double> o;
   o.target.translation = Eigen::Vector3d(0.5, -2, 0.25);
   o.node_indices.resize(2);
@@ -252,17 +267,19 @@ TEST_CASE("MLP executor maps features to clamped torques", "[executor][mlp]") {
   o.node_velocities = Eigen::Matrix<double, 2, 3>::Zero();
   Array3 action = Array3::Zero(3, 3);
   executor.act(o, action);
-  // Element 0 is clamped: 0. Element 1: features 3..5 = target rotation column 0 = (1, 0, 0).
-  CHECK(action.row(0).norm() == 0.0);
+  // Row 0: features 0..2 = target translation, passed on unclamped (the action space clamps).
+  CHECK(action.row(0) == Eigen::RowVector3d(50, -200, 25));
+  // Row 1: features 3..5 = target rotation column 0 = (1, 0, 0).
   CHECK(action(1, 0) == Approx(100));
   CHECK(action(1, 1) == Approx(0).margin(1e-12));
-  // Element 2: features 6..8 = (0, 1, 0) -> (0, 100, 0) plus bias 1 on the twist.
+  // Row 2: features 6..8 = (0, 1, 0) -> (0, 100, 0) plus bias 1 on the twist.
   CHECK(action(2, 1) == Approx(100));
   CHECK(action(2, 2) == Approx(1));
-  o.target.translation.x() = 10;  // output 1000 N m on element 0 only (clamped anyway)
-  executor.act(o, action);
-  CHECK(action(0, 0) == 0.0);
-  CHECK_THROWS_AS(control::MlpExecutor<double>(control::Mlp<double>::load(write_file("mlp_exec2.txt", text)), 4, {}), manisoft::Error);
+  o.target.translation.x() = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_AS(executor.act(o, action), manisoft::Error);  // refused as a target
+  o.target.translation.x() = 1e308;  // finite input, the network overflows: output 0 = 1e310
+  CHECK_THROWS_WITH(executor.act(o, action), Catch::Contains("network output 0 (action row 0, column 0) is not finite"));
+  CHECK_THROWS_AS(control::MlpExecutor<double>(control::Mlp<double>::load(path), 4), manisoft::Error);
 }
 
 TEST_CASE("malformed MLP weight files are refused with file and line", "[executor][mlp][input]") {

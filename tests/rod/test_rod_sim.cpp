@@ -2,40 +2,19 @@
 // flags, and refuses bad flags with exit code 2 and a message.
 #include <catch2/catch.hpp>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "../support/command_line.hpp"
+
 namespace {
 
-std::vector<std::vector<double>> read_csv(const std::string& path, std::string& header) {
-  std::ifstream in(path);
-  std::getline(in, header);
-  std::vector<std::vector<double>> rows;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::stringstream cells(line);
-    std::string cell;
-    while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
-  return rows;
-}
+using manisoft::test::read_csv;
+using manisoft::test::slurp;
 
-int run(const std::string& arguments, const std::string& log) {
-  const std::string command = std::string(MANISOFT_ROD_SIM) + " " + arguments + " > " + log + " 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+int run(const std::string& arguments, const std::string& log) { return manisoft::test::run_command(MANISOFT_ROD_SIM, arguments, log); }
 
 const std::string scratch = (std::filesystem::temp_directory_path() / "manisoft_rod_sim_test").string();
 

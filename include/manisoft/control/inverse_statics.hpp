@@ -46,6 +46,7 @@
 #include <limits>
 #include <vector>
 
+#include "manisoft/control/action_space.hpp"
 #include "manisoft/core/error.hpp"
 #include "manisoft/math/se3.hpp"
 #include "manisoft/math/so3.hpp"
@@ -81,15 +82,6 @@ ArmModel<Scalar> make_arm_model(const RodParameters<Scalar>& params, Scalar payl
   m.payload_mass = payload_mass;
   return m;
 }
-
-/// Per-element actuation limits of the material-frame torques (N m): |tau_1|, |tau_2| <= bend,
-/// |tau_3| <= twist on every actuated element (all but the clamped element 0).
-template <typename Scalar>
-struct ActuationLimits {
-  Scalar bend = Scalar(40);
-  Scalar twist = Scalar(20);
-  Scalar limit(int component) const { return component < 2 ? bend : twist; }
-};
 
 template <typename Scalar>
 struct InverseStaticsSettings {

@@ -17,20 +17,22 @@
 //   target translation (3), target rotation column-major (9), end-effector translation (3),
 //   end-effector rotation column-major (9), observed node positions (m x 3, node by node),
 //   observed node velocities (m x 3, node by node).
-// Output: n x 3 element torques (element-major: element k's d1, d2, d3), N m, clamped to the
-// actuation limits; element 0 (clamped) gets 0. act() does not allocate.
+// Output: the action, rows x 3 (row-major: row r's d1, d2, d3; rows = the action space's rows:
+// n element torques in N m, or K B-spline control values), passed on unclamped: the action
+// space of the environment applies the actuation limits. A non-finite output is refused naming
+// its index (a policy that emits NaN is an error, not a zero torque). act() does not allocate.
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "manisoft/control/executor.hpp"
-#include "manisoft/control/inverse_statics.hpp"
 #include "manisoft/core/error.hpp"
 
 namespace manisoft::control {
@@ -188,12 +190,11 @@ class MlpExecutor {
   using Scalar = ScalarType;
   using Array3 = Eigen::Matrix<Scalar, Eigen::Dynamic, 3>;
 
-  /// A policy for a rod of n_elements; the network's output size must be 3 n_elements.
-  MlpExecutor(Mlp<Scalar> network, int n_elements, ActuationLimits<Scalar> limits)
-      : network_(std::move(network)), n_elements_(n_elements), limits_(limits) {
-    if (n_elements < 2) detail::fail("MlpExecutor: n_elements = ", n_elements, " must be >= 2");
-    if (network_.output_size() != 3 * n_elements)
-      detail::fail("MlpExecutor: the network outputs ", network_.output_size(), " values, the rod needs 3 x ", n_elements, " = ", 3 * n_elements);
+  /// A policy whose network outputs `action_rows` x 3 values (element-major).
+  MlpExecutor(Mlp<Scalar> network, int action_rows) : network_(std::move(network)), rows_(action_rows) {
+    if (action_rows < 1) detail::fail("MlpExecutor: action_rows = ", action_rows, " must be >= 1");
+    if (network_.output_size() != 3 * action_rows)
+      detail::fail("MlpExecutor: the network outputs ", network_.output_size(), " values, the action needs 3 x ", action_rows, " = ", 3 * action_rows);
     features_.setZero(network_.input_size());
   }
 
@@ -203,11 +204,11 @@ class MlpExecutor {
   static int feature_size(int observed_nodes) { return 24 + 6 * observed_nodes; }
 
   void act(const Observation<Scalar>& o, Array3& action) {
-    validate_observation(o, n_elements_ + 1);
+    validate_observation(o, std::numeric_limits<int>::max());  // the network does not know the rod's node count
     const int m = static_cast<int>(o.node_indices.size());
     if (feature_size(m) != network_.input_size())
       detail::fail("MlpExecutor: the observation gives ", feature_size(m), " features (", m, " nodes), the network expects ", network_.input_size());
-    if (action.rows() != n_elements_) action.resize(n_elements_, 3);
+    if (action.rows() != rows_) action.resize(rows_, 3);
     int f = 0;
     for (int i = 0; i < 3; ++i) features_[f++] = o.target.translation[i];
     for (int c = 0; c < 3; ++c)
@@ -220,20 +221,19 @@ class MlpExecutor {
     for (int j = 0; j < m; ++j)
       for (int i = 0; i < 3; ++i) features_[f++] = o.node_velocities(j, i);
     const auto& out = network_.evaluate(features_);
-    for (int k = 0; k < n_elements_; ++k)
+    for (int k = 0; k < rows_; ++k)
       for (int i = 0; i < 3; ++i) {
-        const Scalar v = std::isfinite(out[3 * k + i]) ? out[3 * k + i] : Scalar(0);
-        action(k, i) = std::clamp(v, -limits_.limit(i), limits_.limit(i));
+        if (!std::isfinite(out[3 * k + i]))
+          detail::fail("MlpExecutor: network output ", 3 * k + i, " (action row ", k, ", column ", i, ") is not finite");
+        action(k, i) = out[3 * k + i];
       }
-    action.row(0).setZero();
   }
 
   const Mlp<Scalar>& network() const { return network_; }
 
  private:
   Mlp<Scalar> network_;
-  int n_elements_;
-  ActuationLimits<Scalar> limits_;
+  int rows_;
   typename Mlp<Scalar>::Vector features_;
 };
 

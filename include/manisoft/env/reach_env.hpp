@@ -13,10 +13,13 @@
 // A held load (`load_mass`) rides in the closed gripper: it is added to the gripper body's mass.
 // `model_error` F makes the simulated Young's modulus (1 + F) times the nominal one; the
 // nominal model (nominal_model()) is what an executor should assume: nominal E, gripper only.
-// Action: n x 3 material-frame element torques, clamped to the actuation limits
-// (ActuationLimits: |tau_1|, |tau_2| <= 150 N m, |tau_3| <= 75 N m; element 0 is clamped and
-// takes no torque). The limits are set by what the inverse statics needs: a shape with tip
-// curvature kappa(L) must be held by the tip element's couple B kappa(L) (B = EI = 49 N m^2).
+// Action: a policy class (control/action_space.hpp), the template parameter ActionPolicy:
+// ElementTorqueAction (n x 3 material-frame element torques, the default) or
+// BsplineMuscleAction (K x 3 control values of a muscle couple profile). Either way the element
+// torques are clamped to the actuation limits (ActuationLimits: |tau_1|, |tau_2| <= 150 N m,
+// |tau_3| <= 75 N m; element 0 is clamped and takes no torque); info.clipped counts the clamped
+// entries. The limits are set by what the inverse statics needs: a shape with tip curvature
+// kappa(L) must be held by the tip element's couple B kappa(L) (B = EI = 49 N m^2).
 // Observation: target, end-effector pose, positions and velocities of every
 // `observe_stride`-th node (always including the tip).
 // Reward: R = R_d + R_s of the paper (d = |d_p| + 0.2 |d_r|; R_d with k1 = 0.5, k2 = 1.5,
@@ -55,6 +58,7 @@
 #include <random>
 #include <string>
 
+#include "manisoft/control/action_space.hpp"
 #include "manisoft/control/executor.hpp"
 #include "manisoft/control/inverse_statics.hpp"
 #include "manisoft/core/error.hpp"
@@ -113,9 +117,12 @@ struct ReachInfo {
   int clipped = 0;                 ///< action entries clipped to the limits in this step
 };
 
-template <template <class> class Damping = damping::AnalyticalLinear>
+template <template <class> class Damping = damping::AnalyticalLinear,
+          template <class> class ActionPolicy = control::ElementTorqueAction>
 class ReachEnv {
  public:
+  using Action = ActionPolicy<double>;
+  static_assert(control::ActionSpace<Action>);
   using Rod = CosseratRod<double, Damping, bc::ClampedBase, integrator::PositionVerlet, forcing::Gravity,
                           forcing::ElementTorques>;
   using World = SoftArmWorld<Rod>;
@@ -130,8 +137,8 @@ class ReachEnv {
     ReachInfo info;
   };
 
-  ReachEnv(ReachEnvConfig config, Damping<double> damping)
-      : config_(config), damping_(damping),
+  ReachEnv(ReachEnvConfig config, Damping<double> damping, typename Action::Settings action_settings = {})
+      : config_(config), damping_(damping), action_space_(config.rod.n_elements, config.rod.length, config.limits, action_settings),
         nominal_(control::make_arm_model(config.rod, config.gripper_mass)),
         statics_(nominal_, {}, config.limits) {
     detail::require_positive("dt", config_.dt);
@@ -157,13 +164,15 @@ class ReachEnv {
     observation_.node_positions.setZero(observation_.node_indices.size(), 3);
     observation_.node_velocities.setZero(observation_.node_indices.size(), 3);
     d_history_.setZero(config_.stability_window);
-    clipped_action_.setZero(n, 3);
+    element_torques_.setZero(n, 3);
   }
 
   /// The model an executor should assume: nominal stiffness, gripper payload, no load.
   const control::ArmModel<double>& nominal_model() const { return nominal_; }
   const ReachEnvConfig& config() const { return config_; }
   int n_elements() const { return config_.rod.n_elements; }
+  /// The action space: rows() x 3 actions, apply() to element torques, project() from them.
+  const Action& action_space() const { return action_space_; }
 
   /// Starts an episode: draws the target of `seed` and puts the arm straight at rest.
   const control::Observation<double>& reset(std::uint64_t seed) {
@@ -183,22 +192,12 @@ class ReachEnv {
     return observation_;
   }
 
-  /// Applies `action` (n x 3, clamped to the limits) for one control step.
+  /// Applies `action` (action_space().rows() x 3; element torques clamped to the limits) for
+  /// one control step. A malformed or non-finite action is refused before anything changes.
   StepResult step(const Array3& action) {
     if (!world_) detail::fail("ReachEnv::step called before reset");
-    const int n = n_elements();
-    if (action.rows() != n || action.cols() != 3)
-      detail::fail("ReachEnv::step expects an action of ", n, " x 3, got ", action.rows(), " x ", action.cols());
-    info_.clipped = 0;
-    for (int k = 0; k < n; ++k)
-      for (int c = 0; c < 3; ++c) {
-        const double a = action(k, c);
-        if (!std::isfinite(a)) detail::fail("ReachEnv::step: action entry (", k, ", ", c, ") = ", a, " is not finite");
-        const double lim = k == 0 ? 0.0 : config_.limits.limit(c);
-        clipped_action_(k, c) = std::clamp(a, -lim, lim);
-        if (k > 0 && std::abs(a) > lim) ++info_.clipped;
-      }
-    world_->rod().template forcing<forcing::ElementTorques>().set(clipped_action_);
+    info_.clipped = action_space_.apply(action, element_torques_);
+    world_->rod().template forcing<forcing::ElementTorques>().set(element_torques_);
     if (!info_.diverged) {
       try {
         for (int s = 0; s < config_.substeps; ++s) {
@@ -330,6 +329,7 @@ class ReachEnv {
 
   ReachEnvConfig config_;
   Damping<double> damping_;
+  Action action_space_;
   control::ArmModel<double> nominal_;
   control::InverseStatics<double> statics_;
   std::optional<World> world_;
@@ -341,7 +341,7 @@ class ReachEnv {
   int target_draws_ = 0;
   Eigen::VectorXd d_history_;
   long d_count_ = 0;
-  Array3 clipped_action_;
+  Array3 element_torques_;
 };
 
 }  // namespace manisoft::env
