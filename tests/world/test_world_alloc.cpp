@@ -1,13 +1,18 @@
 // A world step allocates no heap memory once the scene is set up and has run: the world_demo
 // scene (table, floor, arm with gripper, eight objects) with the arm pressing the gripper onto the
-// table and moving, and with the gripper holding an object. Global operator new is counted, not
-// assumed.
+// table and moving, and with the gripper holding an object; and a whole reach episode (executor
+// act() after the target's set-up, environment step with reward) allocates nothing either.
+// Global operator new is counted, not assumed.
 #include <catch2/catch.hpp>
 
 #include "../support/allocation_counter.hpp"
 
 #include <cmath>
 
+#include "manisoft/control/mlp_executor.hpp"
+#include "manisoft/control/model_executor.hpp"
+#include "manisoft/control/projected_executor.hpp"
+#include "manisoft/env/reach_env.hpp"
 #include "manisoft/world/arm_world.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
 
@@ -81,4 +86,64 @@ TEST_CASE("rod contact on every element allocates nothing in steady state", "[wo
   CAPTURE(contact.contacts().size());
   CHECK(contact.contacts().size() >= 20);
   CHECK(allocations == 0);
+}
+
+namespace {
+
+/// Allocations during one episode after its set-up: reset(), the executor's first act() (the
+/// target's inverse statics) and the first control step (the world sizes its buffers).
+template <typename Env, typename Executor>
+long episode_allocations(Env& env, Executor& executor, std::uint64_t seed, bool& success) {
+  Torques action = Torques::Zero(env.action_space().rows(), 3);
+  const auto* observation = &env.reset(seed);
+  executor.reset();
+  executor.act(*observation, action);
+  observation = &env.step(action).observation;
+  executor.act(*observation, action);
+  const long before = allocation_count.load();
+  bool done = false;
+  while (!done) {
+    const auto result = env.step(action);
+    observation = &result.observation;
+    done = result.done;
+    success = result.info.success;
+    if (!done) executor.act(*observation, action);
+  }
+  return allocation_count.load() - before;
+}
+
+}  // namespace
+
+TEST_CASE("a reach episode allocates nothing after the target's set-up", "[executor][alloc]") {
+  bool success = false;
+  SECTION("model executor, element torques, with an unknown load (the outer loop re-solves)") {
+    manisoft::env::ReachEnvConfig config;
+    config.load_mass = 0.3;
+    config.model_error = 0.1;
+    manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> env(config, manisoft::damping::AnalyticalLinear<double>(0.1));
+    manisoft::control::ModelExecutor<double> executor(env.nominal_model(), config.limits);
+    CHECK(episode_allocations(env, executor, 5, success) == 0);
+    CHECK(success);
+  }
+  SECTION("model executor through the B-spline projection") {
+    manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear, manisoft::control::BsplineMuscleAction> env(
+        {}, manisoft::damping::AnalyticalLinear<double>(0.1));
+    manisoft::control::ProjectedExecutor executor(manisoft::control::ModelExecutor<double>(env.nominal_model(), env.config().limits),
+                                                  env.action_space());
+    CHECK(episode_allocations(env, executor, 6, success) == 0);
+    CHECK(success);
+  }
+  SECTION("MLP executor") {
+    manisoft::env::ReachEnv<manisoft::damping::AnalyticalLinear> env({}, manisoft::damping::AnalyticalLinear<double>(0.1));
+    const int inputs = manisoft::control::MlpExecutor<double>::feature_size(static_cast<int>(env.reset(1).node_indices.size()));
+    using Mlp = manisoft::control::Mlp<double>;
+    std::vector<Mlp::Layer> layers(2);
+    layers[0].weights = Mlp::Matrix::Constant(16, inputs, 0.01);
+    layers[0].bias = Mlp::Vector::Zero(16);
+    layers[0].activation = manisoft::control::Activation::tanh;
+    layers[1].weights = Mlp::Matrix::Constant(3 * env.n_elements(), 16, 0.1);
+    layers[1].bias = Mlp::Vector::Zero(3 * env.n_elements());
+    manisoft::control::MlpExecutor<double> executor(Mlp(layers), env.n_elements());
+    CHECK(episode_allocations(env, executor, 7, success) == 0);
+  }
 }

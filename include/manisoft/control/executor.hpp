@@ -1,9 +1,11 @@
 // The executor interface (issue 4): a low-level controller that turns a target end-effector
-// SE(3) pose, given in its observation, into material-frame element torques (the action).
+// SE(3) pose, given in its observation, into an action.
 //   Observation: the target pose, the current end-effector pose, and the lab-frame positions and
 //                velocities of selected rod nodes (ascending node indices).
-//   Executor:    reset() before an episode; act(observation, action) writes an n x 3 action
-//                (rows = elements, columns = d1, d2, d3 torques in N m). act() must not allocate.
+//   Executor:    reset() before an episode; act(observation, action) writes a rows x 3 action of
+//                its action space (control/action_space.hpp): n x 3 element torques (columns
+//                d1, d2, d3, N m) or K x 3 B-spline muscle control values. act() must not
+//                allocate. ProjectedExecutor lets an element-torque executor drive any space.
 // Executors see only the observation, never the simulator, so the end-effector model (a tip
 // payload now, a gripper on a spring coupling later) can change without touching them.
 #pragma once

@@ -148,6 +148,14 @@ class RigidWorld {
       manager_->registerObject(fcl_objects_[g].get());
     }
     broadphase_dirty_ = true;
+    // Per-body step buffers at their working size now, so no step allocates for them; candidate
+    // pairs get room for every pair of geoms (at most 16 per geom).
+    const std::size_t bodies = models_.size(), g = geoms_.size();
+    previous_states_.reserve(bodies);
+    solver_bodies_.reserve(bodies);
+    parent_.reserve(bodies);
+    island_min_time_.reserve(bodies);
+    pairs_.reserve(std::min(g * (g - 1) / 2, 16 * g));
     return id;
   }
 
