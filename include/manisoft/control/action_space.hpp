@@ -1,6 +1,6 @@
-// Action spaces of the soft arm (issue 4 part 3; paper section 3.2): how an action becomes the
-// material-frame element torques tau_e (n x 3, rows = elements, columns = d1, d2, d3) that drive
-// the rod, under the actuators' limits. Two policy classes with one interface (ActionSpace):
+// Action spaces of the soft arm (issue 4 part 3; paper section 3, "Simulator"): how an action
+// becomes the material-frame element torques tau_e (n x 3, rows = elements, columns = d1, d2, d3)
+// that drive the rod, under the actuators' limits. Two policy classes, one interface (ActionSpace):
 //
 //   ElementTorqueAction  the action is tau_e itself (n x 3), the paper's action.
 //   BsplineMuscleAction  the action is K x 3 control values of a muscle couple profile T_d(s) per
@@ -13,9 +13,10 @@
 //                        so the couple carried across node k (elements k..n-1 on the far side)
 //                        is sum_{j >= k} tau_j = scale T(s_k): at equilibrium the muscle profile
 //                        is the bending/twisting couple the arm holds there. (Elastica-RL
-//                        evaluates T half an element further out, at s = (k + 1) l0, on current
-//                        lengths; forcing::BsplineMuscleTorques keeps that rule.) Knots: `pinned_ends` (Elastica-RL)
-//                        puts K interior knots in linspace(0, L, K + 2) with zero end values;
+//                        evaluates T one element further out, at s = (k + 1) l0, on current
+//                        lengths; forcing::BsplineMuscleTorques keeps that rule.) Knots:
+//                        `pinned_ends` (Elastica-RL) puts K interior knots in
+//                        linspace(0, L, K + 2) with zero end values;
 //                        otherwise K knots span linspace(0, L, K) and every value is free (a tip
 //                        couple can then bend the last element, which holding a bent tip needs).
 //

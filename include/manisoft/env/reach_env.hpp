@@ -114,7 +114,7 @@ struct ReachInfo {
   int first_success_step = -1;     ///< first control step of the held window, -1 if none
   int step = 0;                    ///< control steps taken
   bool diverged = false;           ///< the simulated rod refused a step (state kept)
-  int clipped = 0;                 ///< action entries clipped to the limits in this step
+  int clipped = 0;                 ///< element torque entries clamped to the limits in this step
 };
 
 template <template <class> class Damping = damping::AnalyticalLinear,
