@@ -8,7 +8,13 @@
 // A stiffness error is estimated online (below); anything else (an unknown held load, the
 // damping of the simulated rod) is left to the feedback and the outer loop.
 //
-// Per control step, action = clamp(tau_ff + tau_fb), element 0 (clamped) = 0:
+// Per control step, action = clamp(tau_ff + tau_fb), element 0 (clamped) = 0; from the tip
+// inwards, what the clamp cuts off an element is added to the next proximal element
+// (carry_saturation): the couple carried across every other node is then still the one asked for
+// (sum_{j >= k} tau_j), only the node between the two elements sees the difference. Measured on
+// table targets whose feed-forward needs > 90% of the limit: without the carry a few reached the
+// tolerance and later slipped into a slow saturated oscillation (final errors up to 65 mm over
+// 300 targets x 4 conditions), with it the largest final error is 7.7 mm.
 //   tau_ff    the inverse statics feed-forward of the current shape target (inverse_statics.hpp),
 //             with the elastic part scaled by the stiffness estimate s_hat;
 //   tau_fb    node forces F_j = -m_j (kd v_j + kp (x_j - x*_j)) (positions and velocities of
@@ -78,6 +84,7 @@ struct ModelExecutorSettings {
   int estimate_delay = 20;                 ///< control steps after the ramp before estimating
   Scalar estimate_speed_gate = Scalar(1);  ///< m/s: estimate only while every observed node is slower
   Scalar min_stiffness_scale = Scalar(0.5);  ///< bounds of s_hat
+  bool carry_saturation = true;            ///< a clamped element's excess goes to the next proximal one
   Scalar max_stiffness_scale = Scalar(2);
   Scalar twist_gain = Scalar(20);          ///< N m/rad: twist couple -k phi_tip (s_k / L) on the tip twist error
   Scalar twist_damping = Scalar(0);        ///< N m s/rad: twist couple -c w_tip (s_k / L) from end-effector
@@ -161,6 +168,7 @@ class ModelExecutor {
     const RodState<Scalar>& desired = statics_.desired_state();
     const auto& limits = statics_.limits();
     Vector3 distal = Vector3::Zero();
+    Vector3 excess = Vector3::Zero();  // clamped-off torque carried to the next proximal element
     Scalar tip_twist = 0;
     bool saturated = false;
     for (int k = n - 1; k >= 0; --k) {
@@ -182,9 +190,10 @@ class ModelExecutor {
       couple[2] -= share * (settings_.twist_gain * tip_twist + settings_.twist_damping * tip_twist_rate);
       for (int i = 0; i < 3; ++i) {
         const Scalar lim = limits.limit(i);
-        const Scalar a = ff(k, i) + couple[i];
+        const Scalar a = ff(k, i) + couple[i] + (settings_.carry_saturation ? excess[i] : Scalar(0));
         if (k > 0 && std::abs(a) > lim) saturated = true;
         action(k, i) = std::clamp(a, -lim, lim);
+        excess[i] = a - action(k, i);
       }
     }
     action.row(0).setZero();
