@@ -1,7 +1,9 @@
 // Rod elements against the world (rod_contact::Capsules): a rod lying on the table carries its
 // weight (total normal force = m g within 1 %, penetration far below 1 mm), equal and opposite
 // impulses between a free rod and a free box (linear momentum conserved to round-off), a rod on
-// a slope slides with a = g (sin - mu cos) when it must and holds when mu > tan, and an arm swung
+// a slope slides with a = g (sin - mu cos) when it must and holds still (static friction, no
+// creep) when mu > tan, a rod on a table pushed along its axis holds below mu m g and slides with
+// a = (F - mu m g) / m above, pushed across its axis it rolls (a = 2 F / (3 m)), and an arm swung
 // at its top speed into a box obstacle stops against it and never passes through.
 #include <catch2/catch.hpp>
 
@@ -118,22 +120,119 @@ TEST_CASE("a rod on a slope: Coulomb sliding and sticking", "[world][rod_contact
     rp.normal = r * Vector3d::UnitZ();
     rp.base_position = r * Vector3d(-0.5, 0, rp.radius);
     FreeRod rod(rp, kDt, manisoft::damping::UniformExp<double>(0));
+    const Vector3d down = r * Vector3d::UnitX();
+    auto mean_position = [&] { return Vector3d(rod.state().positions.colwise().mean().transpose()); };
     for (int i = 0; i < 1000; ++i) step(rod, world, contact);  // 0.2 s
     const Vector3d v1 = rod.state().velocities.colwise().mean().transpose();
-    for (int i = 0; i < 2500; ++i) step(rod, world, contact);  // 0.5 s more
+    const Vector3d x1 = mean_position();
+    // 0.5 s more; the mean over it of the velocity along the slope.
+    double mean_v_down = 0;
+    for (int i = 0; i < 2500; ++i) {
+      step(rod, world, contact);
+      mean_v_down += rod.state().velocities.colwise().mean().dot(down.transpose()) / 2500;
+    }
     const Vector3d v2 = rod.state().velocities.colwise().mean().transpose();
-    const Vector3d down = r * Vector3d::UnitX();
+    const double displacement = (mean_position() - x1).norm();
     const double accel = (v2 - v1).dot(down) / (2500 * kDt);
     const double expected = 9.81 * (std::sin(slope) - mu_pair * std::cos(slope));
-    CAPTURE(mu_pair, accel, expected, v2.dot(down));
+    CAPTURE(mu_pair, accel, expected, v2.dot(down), mean_v_down, displacement);
+    INFO("mean velocity along the slope " << mean_v_down << " m/s, displacement over 0.5 s " << displacement << " m");
     if (expected > 0) {
       // Coulomb sliding along the rod's axis.
       CHECK(accel == Approx(expected).epsilon(0.05));
     } else {
-      // Sticks up to the regularization's creep (F_t / c_t: mm/s).
-      CHECK(std::abs(v2.dot(down)) < 0.01);
+      // Static friction: the stick-slip springs hold it (elastic pre-slip of micrometres, no creep).
+      CHECK(std::abs(mean_v_down) < 1e-4);
+      CHECK(displacement < 1e-4);
+      for (const auto& c : contact.contacts()) CHECK(c.sticking);
     }
   }
+}
+
+TEST_CASE("a rod on a table pushed along its axis: static friction, then Coulomb sliding", "[world][rod_contact]") {
+  // Pushed along its axis: a push across it would roll the rod (not a test of static friction).
+  constexpr double kMu = 0.5;
+  for (double load_ratio : {0.6, 1.5}) {  // F / (mu m g)
+    manisoft::RigidWorld world;
+    manisoft::RigidBodyDesc d;
+    d.shape = manisoft::Box<double>{Vector3d(2.0, 0.5, 0.05)};
+    d.position = Vector3d(0.5, 0, -0.05);  // top face at z = 0
+    d.is_static = true;
+    d.friction = kMu;
+    world.add_body(d);
+    manisoft::rod_contact::CapsuleParameters cp;
+    cp.friction = kMu;  // pair mu = kMu
+    manisoft::rod_contact::Capsules contact(cp);
+    RodParameters<double> rp;
+    rp.base_position = Vector3d(0, 0, rp.radius);
+    FreeRod rod(rp, kDt, manisoft::damping::UniformExp<double>(0));
+    const double mass = rod.model().total_mass();
+    const double push = load_ratio * kMu * mass * 9.81;
+    auto mean_x = [&] { return rod.state().positions.col(0).mean(); };
+    auto mean_vx = [&] { return rod.state().velocities.col(0).mean(); };
+    auto pushed_step = [&] {
+      // The push on every node in proportion to its mass: a uniform acceleration, no bending.
+      for (int i = 0; i <= rod.n_elements(); ++i)
+        rod.state().external_forces(i, 0) += push * rod.model().node_masses[i] / mass;
+      step(rod, world, contact);
+    };
+    for (int i = 0; i < 1000; ++i) step(rod, world, contact);  // 0.2 s: settle on the table
+    const double x0 = mean_x();
+    if (load_ratio < 1) {
+      double max_drift = 0;
+      for (int i = 0; i < 5000; ++i) {  // 1 s under the push
+        pushed_step();
+        max_drift = std::max(max_drift, std::abs(mean_x() - x0));
+      }
+      const double drift = mean_x() - x0;
+      std::size_t sticking = 0;
+      for (const auto& c : contact.contacts()) sticking += c.sticking;
+      CAPTURE(mass, push, drift, max_drift, mean_vx(), sticking, contact.contacts().size());
+      INFO("drift " << drift << " m, largest " << max_drift << " m, mean velocity " << mean_vx() << " m/s");
+      CHECK(max_drift < 1e-4);  // the elastic pre-slip F / (40 k_t): 6 um
+      CHECK(std::abs(mean_vx()) < 1e-4);
+      CHECK(sticking == contact.contacts().size());
+    } else {
+      for (int i = 0; i < 1000; ++i) pushed_step();  // 0.2 s: break away
+      const double v1 = mean_vx();
+      for (int i = 0; i < 2500; ++i) pushed_step();  // 0.5 s of sliding
+      const double v2 = mean_vx();
+      const double accel = (v2 - v1) / (2500 * kDt);
+      const double expected = (push - kMu * mass * 9.81) / mass;
+      CAPTURE(mass, push, accel, expected, v2, mean_x() - x0);
+      CHECK(accel == Approx(expected).epsilon(0.05));
+    }
+  }
+}
+
+TEST_CASE("a rod on a table pushed across its axis rolls without slipping", "[world][rod_contact]") {
+  // A solid cylinder pushed at its axis rolls: a = F / (m + J / r^2) = 2 F / (3 m), the friction
+  // F / 3 below mu m g. The anchors are re-based every step, so the rolling (contact point
+  // wandering over the rod's surface) does not load the stick-slip springs.
+  manisoft::RigidWorld world;
+  add_box(world, Vector3d(0.5, 0, -0.05), Vector3d(1.0, 1.0, 0.05), true, 0, "table");
+  manisoft::rod_contact::Capsules contact;
+  RodParameters<double> rp;
+  rp.base_position = Vector3d(0, 0, rp.radius);
+  FreeRod rod(rp, kDt, manisoft::damping::UniformExp<double>(0));
+  const double mass = rod.model().total_mass();
+  const double push = 0.2 * mass * 9.81;
+  auto pushed_step = [&] {
+    for (int i = 0; i <= rod.n_elements(); ++i) rod.state().external_forces(i, 1) += push * rod.model().node_masses[i] / mass;
+    step(rod, world, contact);
+  };
+  for (int i = 0; i < 1000; ++i) step(rod, world, contact);  // settle
+  for (int i = 0; i < 500; ++i) pushed_step();
+  const double v1 = rod.state().velocities.col(1).mean();
+  for (int i = 0; i < 2500; ++i) pushed_step();
+  const double v2 = rod.state().velocities.col(1).mean();
+  const double accel = (v2 - v1) / (2500 * kDt);
+  const double spin = rod.state().angular_velocities.col(2).mean();  // about d3 (the axis)
+  std::size_t sticking = 0;
+  for (const auto& c : contact.contacts()) sticking += c.sticking;
+  CAPTURE(mass, push, accel, 2 * push / (3 * mass), v2, spin, spin * rp.radius, sticking, contact.contacts().size());
+  CHECK(accel == Approx(2 * push / (3 * mass)).epsilon(0.05));
+  CHECK(std::abs(std::abs(spin) * rp.radius - v2) < 0.05 * v2);  // rolling: omega r = v
 }
 
 namespace {

@@ -1,18 +1,34 @@
 // Rod-contact policies of SoftArmWorld (issue 3, "rod against the world"): every rod element is a
 // capsule (nodes k, k + 1, the rod's radius) that touches the rigid bodies of the world (table,
-// obstacles, objects) through a penalty force with damping and regularized Coulomb friction.
+// obstacles, objects) through a penalty force with damping and Coulomb friction with static
+// friction (a tangential stick-slip spring, Cundall & Strack 1979).
 // The force at a contact point goes to the element's two nodes split by the segment parameter t
 // ((1 - t) on node k, t on node k + 1), its moment about the rod axis to the element (material
 // frame), and the opposite force to the body at the contact point (RigidWorld::add_force_at_point).
 //
 // Contact law at a point with penetration depth p = -separation > 0, unit normal n (rod -> body),
 // relative velocity v = v_rod - v_body of the two material points (rod: (1-t) v_k + t v_{k+1} +
-// omega x r, body: v + w x r):
-//   normal    f_n = max(0, k p + c (v . n)),           force on the rod  -f_n n
-//   friction  f_t = -min(mu f_n, c_t |v_t|) v_t/|v_t|,  v_t = v - (v . n) n    (on the rod)
-// mu = sqrt(mu_rod mu_body) (as rigid pairs). The viscous branch c_t |v_t| is the regularization:
-// below the Coulomb limit a tangentially loaded contact creeps at v_t = F_t / c_t (a few mm/s for a
-// node under its own weight on a 30 degree slope); above it, it slides with Coulomb friction.
+// omega x r, body: v + w x r), v_n = v . n, v_t = v - v_n n:
+//   normal    f_n = max(0, k p + c v_n),                         force on the rod  -f_n n
+//   friction  f_t* = -(k_t d_t + c_t v_t)                         (trial, on the rod)
+//             f_t  = f_t*                     if |f_t*| <= mu f_n  (stick)
+//             f_t  = mu f_n f_t* / |f_t*|     otherwise            (kinetic slip)
+// mu = sqrt(mu_rod mu_body) (as rigid pairs). d_t is the tangential separation of the two sides
+// of the contact: a rod material point x_r (segment parameter t_a of element k plus the surface
+// offset r_a in the element's material frame) and a body anchor x_a (in the body's frame, so it
+// moves with the body), d = x_r - x_a, d_t = d - (d . n) n. When a point first appears (element
+// k, geometry g, point slot i of the narrow phase) x_a = x_r and d_t = 0. On slip the anchor is
+// slid so that the spring alone sits on the Coulomb cone, d_t <- -f_t / k_t (|k_t d_t| = mu f_n,
+// along the slip), so sliding resumes at once when the load reverses. After every step the
+// anchor is re-based onto the current contact point c keeping d_t (x_r <- c, x_a <- c - d_t),
+// so d_t grows by exactly the relative motion of the two material points over the next step
+// (v_t dt for small steps) even when the contact point wanders over the rod's surface (rolling,
+// a tilting element switching between one and two points). A tangentially loaded contact below
+// the Coulomb limit holds at the spring's elastic pre-slip |d_t| = F_t / k_t (micrometres) with
+// no creep; above it, it slides with Coulomb friction. Anchors of points that disappear (no
+// penetration in an apply()) are dropped. Storage: kAnchorSlots per element, sized at the first
+// apply(); a point that finds all of its element's slots taken by live anchors (more than
+// kAnchorSlots points on one element) gets no spring this step (f_t* = -c_t v_t, capped).
 //
 // Stiffness and stability (explicit forces, dt = 2e-4 s). Per point, m_eff = 1 / (1/m_rod + 1/m_b)
 // with 1/m_rod = (1-t)^2/m_k + t^2/m_{k+1} + r^2/J_3 (the twist of the element moves its surface)
@@ -22,19 +38,26 @@
 // k <= m_eff (omega_max / dt)^2 with omega_max dt = 0.3 (a node carries up to four points: two
 // elements, two points each, so omega dt <= 0.6, far below the leapfrog limit 2). For an interior
 // node on a static table omega dt = sqrt(1e5 / 0.13) 2e-4 = 0.18 (uncapped). Damping is
-// c = 2 zeta sqrt(k m_eff) with zeta = 1 (critical: c dt / m_eff = 2 omega dt <= 0.6), and the
-// friction viscosity c_t = stick_rate m_eff with stick_rate dt = 0.2 (four points: 0.8 < 2).
+// c = 2 zeta sqrt(k m_eff) with zeta = 1 (critical: c dt / m_eff = 2 omega dt <= 0.6).
+// The tangential spring is the same oscillator in the tangent plane: k_t = min(ratio_t k_nominal,
+// m_eff (omega_max / dt)^2) with ratio_t = 1 (so omega_t dt <= 0.3 per point, <= 0.6 per node
+// with four points, as the normal), c_t = 2 zeta_t sqrt(k_t m_eff) with zeta_t = 1 (critical: an
+// elastic pre-slip rings down in a period instead of oscillating, c_t dt / m_eff <= 0.6). The
+// tangential and normal springs act along orthogonal directions, so each keeps its own margin.
+// Elastic pre-slip of a rod lying on a table under a sideways load F: F / (40 k_t) = 2.5e-7 m/N.
 //
 // Broad phase (the world step budget is ~10 us): element AABBs (inflated by radius + margin) and
 // their union; a body is skipped unless its bounding sphere's box meets the union; a geometry
 // unless its bounds meet the union; then each element whose box meets the geometry's bounds goes
 // to the narrow phase (contact/narrow_phase.hpp: analytic capsule-sphere/capsule/box, SAT is not
 // used for capsules, FCL for capsule vs cylinder or mesh). No heap allocation in steady state
-// except on the FCL fallback path (FCL's result vectors), as in RigidWorld.
+// except on the FCL fallback path (FCL's result vectors), as in RigidWorld. The anchors are
+// looked up by (geometry, slot) in the element's slots in a fixed order: deterministic.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -50,7 +73,8 @@ struct CapsuleParameters {
   double stiffness = 1e5;          ///< k, N/m per contact point (nominal; capped for stability)
   double damping_ratio = 1.0;      ///< zeta of the normal spring on the point's effective mass
   double friction = 0.6;           ///< mu of the rod surface (pairs: sqrt(mu_rod mu_body))
-  double stick_rate_dt = 0.2;      ///< c_t dt / m_eff of the friction regularization
+  double tangential_stiffness_ratio = 1.0;  ///< k_t / k of the stick-slip spring (capped as k)
+  double tangential_damping_ratio = 1.0;    ///< zeta_t of the stick-slip spring on m_eff
   double max_omega_dt = 0.3;       ///< stiffness cap: sqrt(k / m_eff) dt <= this
   double margin = 1e-3;            ///< m: broad-phase inflation of element boxes
 
@@ -58,8 +82,10 @@ struct CapsuleParameters {
     detail::require_positive("rod_contact stiffness", stiffness);
     detail::require_non_negative("rod_contact damping_ratio", damping_ratio);
     detail::require_non_negative("rod_contact friction", friction);
-    detail::require_non_negative("rod_contact stick_rate_dt", stick_rate_dt);
-    if (!(stick_rate_dt <= 1.0)) detail::fail("rod_contact stick_rate_dt = ", stick_rate_dt, " must be <= 1 (explicit stability)");
+    detail::require_non_negative("rod_contact tangential_stiffness_ratio", tangential_stiffness_ratio);
+    detail::require_non_negative("rod_contact tangential_damping_ratio", tangential_damping_ratio);
+    if (!(tangential_damping_ratio <= 1.0))
+      detail::fail("rod_contact tangential_damping_ratio = ", tangential_damping_ratio, " must be <= 1 (explicit stability)");
     detail::require_positive("rod_contact max_omega_dt", max_omega_dt);
     if (!(max_omega_dt <= 0.5)) detail::fail("rod_contact max_omega_dt = ", max_omega_dt, " must be <= 0.5 (explicit stability)");
     detail::require_non_negative("rod_contact margin", margin);
@@ -77,12 +103,15 @@ struct RodContactPoint {
   double separation = 0;                               ///< < 0: penetration
   double normal_force = 0;                             ///< f_n >= 0 [N]
   Eigen::Vector3d force_on_rod = Eigen::Vector3d::Zero();  ///< -f_n n + f_t [N], lab
+  bool sticking = false;  ///< friction inside the Coulomb cone (static), else sliding
 };
 
 /// Rod elements as capsules against every body of the world (see the header comment).
 class Capsules {
  public:
   using Vec3 = Eigen::Vector3d;
+  /// Stick-slip anchors kept per rod element (points of all geometries touching it).
+  static constexpr int kAnchorSlots = 8;
 
   Capsules() = default;
   explicit Capsules(const CapsuleParameters& p) : params_(p) { params_.validate(); }
@@ -95,6 +124,12 @@ class Capsules {
   }
   void include(BodyId id) { excluded_.erase(std::remove(excluded_.begin(), excluded_.end(), id), excluded_.end()); }
   bool is_excluded(BodyId id) const { return std::find(excluded_.begin(), excluded_.end(), id) != excluded_.end(); }
+
+  /// Drops every friction anchor (e.g. after teleporting the rod or a body): the next apply()
+  /// starts every contact unloaded.
+  void forget_anchors() {
+    for (auto& a : anchors_) a.seen = 0;
+  }
 
   /// Contact points of the last apply() that carried a force.
   const std::vector<RodContactPoint>& contacts() const { return contacts_; }
@@ -120,6 +155,9 @@ class Capsules {
     contacts_.clear();
     narrow_calls_ = 0;
     max_penetration_ = 0;
+    // Anchors seen in the previous apply() (seen == pass_ - 1) are live; older ones are free.
+    ++pass_;
+    if (anchors_.size() != std::size_t(n) * kAnchorSlots) anchors_.assign(std::size_t(n) * kAnchorSlots, Anchor{});
 
     element_lo_.resize(std::size_t(n));
     element_hi_.resize(std::size_t(n));
@@ -154,6 +192,33 @@ class Capsules {
   }
 
  private:
+  /// Stick-slip anchor of one contact point (see the header comment): the rod material point
+  /// (segment parameter, surface offset in the element's material frame) and the body point (body
+  /// frame, about the centre of mass) whose tangential separation is the spring's extension.
+  struct Anchor {
+    std::uint64_t seen = 0;  ///< apply() pass that last used it (live if the previous one)
+    std::uint32_t geom = 0;
+    int slot = 0;            ///< point index in the narrow phase's contact set
+    double segment_parameter = 0;
+    Vec3 rod_offset_material = Vec3::Zero();
+    Vec3 body_point = Vec3::Zero();
+  };
+
+  /// The live anchor of (element k, geometry g, point slot i), else a free slot for it (marked
+  /// new by seen != pass_ - 1), else nullptr (all slots held by live anchors).
+  Anchor* find_anchor(int k, std::uint32_t g, int i) {
+    Anchor* first = anchors_.data() + std::size_t(k) * kAnchorSlots;
+    Anchor* free_slot = nullptr;
+    for (Anchor* a = first; a != first + kAnchorSlots; ++a) {
+      if (a->seen + 1 == pass_) {
+        if (a->geom == g && a->slot == i) return a;
+      } else if (a->seen != pass_ && free_slot == nullptr) {
+        free_slot = a;
+      }
+    }
+    return free_slot;
+  }
+
   static bool overlaps(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
     return (alo.array() <= bhi.array()).all() && (blo.array() <= ahi.array()).all();
   }
@@ -229,11 +294,38 @@ class Capsules {
       max_penetration_ = std::max(max_penetration_, depth);
       Vec3 f_rod = -fn * n_lab;
       const Vec3 vt = v_rel - vn * n_lab;
-      const double vt_norm = vt.norm();
-      if (vt_norm > 0 && fn > 0 && mu > 0) {
-        const double c_t = params_.stick_rate_dt * m_eff / dt;
-        const double ft = std::min(mu * fn, c_t * vt_norm);
-        f_rod -= (ft / vt_norm) * vt;
+      // Stick-slip spring: the tangential separation d_t of the anchor's two points (rod material
+      // point x_r, body point x_a), zero for a new point.
+      Anchor* anchor = find_anchor(k, g, i);
+      Vec3 d_tan = Vec3::Zero();
+      if (anchor != nullptr && anchor->seen + 1 == pass_) {
+        const double ta = anchor->segment_parameter;
+        const Vec3 x_r = (1 - ta) * p0 + ta * p1 + q.transpose() * anchor->rod_offset_material;
+        const Vec3 x_a = bs.position + bs.rotation * anchor->body_point;
+        const Vec3 d = x_r - x_a;
+        d_tan = d - d.dot(n_lab) * n_lab;
+      }
+      const double k_t = std::min(params_.tangential_stiffness_ratio * params_.stiffness, k_cap);
+      const double c_t = 2.0 * params_.tangential_damping_ratio * std::sqrt(k_t * m_eff);
+      // f_t* = -(k_t d_t + c_t v_t); on the Coulomb cone if |f_t*| > mu f_n.
+      Vec3 ft = -(k_t * d_tan + c_t * vt);
+      if (anchor == nullptr) ft = -c_t * vt;
+      const double ft_norm = ft.norm();
+      const double ft_max = mu * fn;
+      const bool sticking = ft_norm <= ft_max;
+      if (!sticking) {
+        ft *= ft_max / ft_norm;                             // kinetic: |f_t| = mu f_n, along f_t*
+        d_tan = k_t > 0 ? Vec3(-ft / k_t) : Vec3::Zero();  // anchor slid: the spring on the cone
+      }
+      f_rod += ft;
+      if (anchor != nullptr) {
+        // Re-base onto the current contact point c = axis point + arm, keeping d_t.
+        anchor->seen = pass_;
+        anchor->geom = g;
+        anchor->slot = i;
+        anchor->segment_parameter = t;
+        anchor->rod_offset_material = q * arm;
+        anchor->body_point = bs.rotation.transpose() * (cp.position - d_tan - bs.position);
       }
       if (fn == 0) continue;
       // Rod: nodes by the segment parameter, the moment of the force about the axis to the element.
@@ -252,6 +344,7 @@ class Capsules {
       rc.separation = cp.separation;
       rc.normal_force = fn;
       rc.force_on_rod = f_rod;
+      rc.sticking = sticking;
       contacts_.push_back(rc);
     }
   }
@@ -264,6 +357,8 @@ class Capsules {
   std::shared_ptr<fcl::Capsuled> fcl_capsule_;
   contact::ContactSet set_;
   contact::NarrowPhaseScratch scratch_;
+  std::vector<Anchor> anchors_;  ///< kAnchorSlots per element
+  std::uint64_t pass_ = 1;       ///< apply() count (+1), for the anchors' liveness
   int narrow_calls_ = 0;
   double max_penetration_ = 0;
 };
