@@ -31,6 +31,7 @@
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/control/projected_executor.hpp"
 #include "manisoft/env/reach_env.hpp"
+#include "manisoft/env/rollout.hpp"
 
 namespace {
 
@@ -110,31 +111,17 @@ int run(const Options& o, Executor& executor, Env& env) {
   int successes = 0;
   double steps_sum = 0, variance_sum = 0, step_us_sum = 0, setup_us_sum = 0, setup_us_max = 0, setup_cpu_max = 0, setup_cpu_sum = 0;
   long step_count = 0;
-  Eigen::Matrix<double, Eigen::Dynamic, 3> action = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(env.action_space().rows(), 3);
   for (int i = 0; i < o.targets; ++i) {
-    const auto* observation = &env.reset(static_cast<std::uint64_t>(o.seed) * 1000003ull + static_cast<std::uint64_t>(i));
-    executor.reset();
-    double min_d = 1e300, setup_us = 0, setup_cpu_us = 0, target_step_us = 0;
+    const std::uint64_t seed = static_cast<std::uint64_t>(o.seed) * 1000003ull + static_cast<std::uint64_t>(i);
+    double min_d = 1e300;
     long clipped = 0;
-    manisoft::env::ReachInfo info;
-    for (int t = 0; t < env.config().horizon; ++t) {
-      const std::clock_t c0 = t == 0 ? std::clock() : 0;
-      const auto t0 = std::chrono::steady_clock::now();
-      executor.act(*observation, action);
-      const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
-      if (t == 0) {
-        setup_us = us;
-        setup_cpu_us = 1e6 * double(std::clock() - c0) / CLOCKS_PER_SEC;
-      } else {
-        target_step_us += us;
-      }
-      const auto result = env.step(action);
-      observation = &result.observation;
-      info = result.info;
-      clipped += info.clipped;
-      min_d = std::min(min_d, info.error.distance);
-      if (result.done) break;
-    }
+    const auto record = manisoft::env::rollout(env, executor, seed, [&](const auto& step) {
+      clipped += step.result.info.clipped;
+      min_d = std::min(min_d, step.result.info.error.distance);
+    });
+    const auto& info = record.info;
+    const double setup_us = 1e6 * record.first_act_seconds, setup_cpu_us = 1e6 * record.first_act_cpu_seconds;
+    const double target_step_us = 1e6 * record.act_seconds;
     const double variance = env.stability_variance();
     const int steps = std::max(1, info.step - 1);
     step_us_sum += target_step_us;

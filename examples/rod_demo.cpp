@@ -13,7 +13,7 @@ namespace {
 
 using Rod = manisoft::rod::CosseratRod<double, manisoft::rod::damping::AnalyticalLinear, manisoft::rod::bc::ClampedBase,
                                   manisoft::rod::integrator::PositionVerlet, manisoft::rod::forcing::Gravity,
-                                  manisoft::rod::forcing::BsplineMuscleTorques>;
+                                  manisoft::rod::forcing::ElasticaRLMuscleTorques>;
 
 /// Draws the centrelines (x right, z up) into a character grid, one symbol per snapshot.
 void draw(const std::vector<std::pair<char, Eigen::MatrixX3d>>& shapes) {
@@ -42,7 +42,7 @@ void draw(const std::vector<std::pair<char, Eigen::MatrixX3d>>& shapes) {
 
 int main() {
   Rod rod(manisoft::rod::RodParameters<double>{}, 2e-4, manisoft::rod::damping::AnalyticalLinear<double>(0.1));
-  auto& muscles = rod.forcing<manisoft::rod::forcing::BsplineMuscleTorques>();
+  auto& muscles = rod.forcing<manisoft::rod::forcing::ElasticaRLMuscleTorques>();
   // Two activation phases (6 control points x {normal, binormal, twist}, scale 75 N m). The
   // muscle is an internal couple: the cross-section near arc length s carries about 75 c(s) N m,
   // against the bending stiffness EI = 49 N m^2 and a gravity moment of up to 38 N m at the base.

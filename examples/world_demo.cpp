@@ -1,15 +1,14 @@
-// world_demo: the ManiSoft tabletop world (issue 3): table, the soft arm mounted behind the table
+// world_demo: the ManiSoft tabletop world: table, the soft arm mounted behind the table
 // (tabletop_scene.hpp), the parallel gripper and eight objects. It
 //   1. (--map) maps the reachable workspace over the table top for 9 candidate mounts (random
 //      bounded actuations settled to equilibrium) and prints the coverage table plus an ASCII map
 //      of the chosen mount (and writes it as a PGM image; WORLD_DEMO_MOUNT="h,pitch_deg" maps one),
-//   2. picks the grasp-capable equilibrium nearest the table's centre line, puts the target cube
-//      under it, and finds by Levenberg-Marquardt on arm equilibria (rod alone, the gripper as a
-//      tip load) the open-loop element torques that put the gripper above the cube, around it, at
-//      a drop-off point 15 cm closer to the base and down,
-//   3. runs the scripted sequence (torques ramped between those equilibria, S = 1 at the cube,
-//      S = 0 at the drop-off) in ArmWorld and writes the trace, one row per control step
-//      (7 substeps of 2e-4 s, 714 Hz).
+//   2. puts the target cube at (0.5, 0) on the table and solves the inverse statics
+//      (rod::InverseStatics, within the actuation limits) for the tool-down gripper poses above
+//      the cube, around it, at a drop-off point 15 cm to the side and down,
+//   3. runs the scripted sequence (the equilibria's feed-forward torques ramped open loop, S = 1
+//      at the cube, S = 0 at the drop-off) in ArmWorld and writes the trace, one row per control
+//      step (7 substeps of 2e-4 s, 714 Hz).
 //
 // Usage: world_demo [--out world_trace.csv] [--map] [--map-pgm workspace.pgm] [--samples N]
 //
@@ -41,6 +40,8 @@
 #include <string>
 #include <vector>
 
+#include "manisoft/rod/inverse_statics.hpp"
+#include "manisoft/rod/settle.hpp"
 #include "manisoft/world/arm_world.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
 
@@ -53,20 +54,15 @@ using Vec3 = Eigen::Vector3d;
 using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 constexpr double kDt = 2e-4;
 
-using SettleRod = rod::CosseratRod<double, rod::damping::UniformExp, rod::bc::ClampedBase, rod::integrator::PositionVerlet, rod::forcing::Gravity,
-                              rod::forcing::ElementTorques, rod::forcing::TipLoad>;
 using Arm = rod::CosseratRod<double, rod::damping::AnalyticalLinear, rod::bc::ClampedBase, rod::integrator::PositionVerlet, rod::forcing::Gravity,
                         rod::forcing::ElementTorques>;
 
 /// Arm equilibria under given element torques (rod only; the gripper as a tip load of its weight).
-class EquilibriumSolver {
+class EquilibriumSampler {
  public:
-  explicit EquilibriumSolver(const rod::RodParameters<double>& rp, double gripper_mass, double grasp_offset)
-      : rod_(rp, kDt, rod::damping::UniformExp<double>(20.0)), grasp_offset_(grasp_offset) {
-    rod::forcing::TipLoad<double> tip;
-    tip.force_lab = Vec3(0, 0, -9.81 * gripper_mass);
-    rod_.forcing<rod::forcing::TipLoad>() = tip;
-    start_ = rod_.state();
+  explicit EquilibriumSampler(const rod::RodParameters<double>& rp, double gripper_mass, double grasp_offset)
+      : rod_(rp, kDt, rod::damping::UniformExp<double>(20.0)), start_(rod_.state()), grasp_offset_(grasp_offset) {
+    rod_.forcing<rod::forcing::TipLoad>().force_lab = Vec3(0, 0, -9.81 * gripper_mass);
   }
   struct Result {
     bool settled = false;
@@ -74,41 +70,44 @@ class EquilibriumSolver {
     Vec3 tool_axis = Vec3::Zero();  ///< d3 of the last element
     double min_node_z = 0;
   };
-  /// Settles from `from` (or the straight rod) under `torques`.
-  Result settle(const Array3& torques, const rod::RodState<double>* from = nullptr) {
-    rod_.state() = from ? *from : start_;
+  /// Settles from the straight rod under `torques` (at most 3 s).
+  Result settle(const Array3& torques) {
+    rod_.restore(start_, 0);
     rod_.forcing<rod::forcing::ElementTorques>().set(torques);
+    rod::SettleCriteria<double> rest;
+    rest.min_time = 0.3;
+    rest.max_time = 3.0;
+    rest.speed = 2e-4;
     Result r;
-    try {
-      for (int block = 0; block < 30; ++block) {  // at most 3 s
-        rod_.step(500);
-        const double speed = rod_.state().velocities.rowwise().norm().maxCoeff();
-        if (block >= 2 && speed < 2e-4) {
-          r.settled = true;
-          break;
-        }
-      }
-    } catch (const Error&) {
-      return r;
-    }
-    const int n = rod_.n_elements();
-    r.tool_axis = rod_.state().director(n - 1).row(2).transpose();
-    r.grasp_center = rod_.state().tip_position() + grasp_offset_ * r.tool_axis;
+    r.settled = rod::settle(rod_, rest);
+    const auto tip = rod_.state().tip_pose();
+    r.tool_axis = tip.rotation.col(2);
+    r.grasp_center = tip.translation + grasp_offset_ * r.tool_axis;
     r.min_node_z = rod_.state().positions.col(2).minCoeff();
     return r;
   }
-  const rod::RodState<double>& state() const { return rod_.state(); }
   int n_elements() const { return rod_.n_elements(); }
 
  private:
-  SettleRod rod_;
+  rod::SettlingRod<double> rod_;
   rod::RodState<double> start_;
   double grasp_offset_;
 };
 
-// ---- 1. actuations at equilibrium -----------------------------------------------------------------
+/// Uniform in [-1, 1) from the engine's raw output (portable across standard libraries).
+double symmetric_uniform(std::mt19937_64& rng) { return 2.0 * double(rng() >> 11) * 0x1.0p-53 - 1.0; }
 
-/// The actuation family the script uses: per bend axis c in {0, 1} a uniform couple a_c on
+/// The tool-down gripper pose whose grasp centre is at `grasp_center` (closing axis along x).
+math::Pose<double> tool_down(const Vec3& grasp_center, const interaction::ParallelGripperParameters& gp) {
+  math::Pose<double> pose;
+  pose.rotation << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // d1 = +x, d2 = -y, d3 = -z
+  pose.translation = grasp_center + Vec3(0, 0, gp.grasp_center().z());
+  return pose;
+}
+
+// ---- 1. actuations sampled by the map -----------------------------------------------------------------
+
+/// The actuation family the map samples: per bend axis c in {0, 1} a uniform couple a_c on
 /// elements 1..n-1 plus a tip couple t_c; parameters (a_0, t_0, a_1, t_1).
 Array3 family(const Eigen::Vector4d& p, int n) {
   Array3 t = Array3::Zero(n, 3);
@@ -119,55 +118,6 @@ Array3 family(const Eigen::Vector4d& p, int n) {
   t(n - 1, 0) += p[1];
   t(n - 1, 1) += p[3];
   return t;
-}
-
-/// Levenberg-Marquardt (finite differences) on the equilibrium: grasp centre at `target`, tool
-/// axis straight down (weight 0.1 m per unit of axis error). Every evaluation settles from the
-/// equilibrium of the current parameters (warm start: small motions settle fast). Returns the
-/// parameters; `error` receives the final position error [m], `result` the equilibrium.
-Eigen::Vector4d solve_actuation(EquilibriumSolver& solver, const Vec3& target, Eigen::Vector4d p, double& error,
-                                EquilibriumSolver::Result& result, rod::RodState<double>& state) {
-  const int n = solver.n_elements();
-  auto residual = [&](const EquilibriumSolver::Result& r) {
-    Eigen::Matrix<double, 6, 1> res;
-    res.head<3>() = r.grasp_center - target;
-    res.tail<3>() = 0.1 * (r.tool_axis - Vec3(0, 0, -1));
-    if (!r.settled) res *= 10;  // flutter: not an equilibrium
-    return res;
-  };
-  result = solver.settle(family(p, n), &state);
-  state = solver.state();
-  auto res = residual(result);
-  double lambda = 1e-2;
-  for (int it = 0; it < 12 && res.head<3>().norm() > 1e-3; ++it) {
-    Eigen::Matrix<double, 6, 4> jac;
-    for (int j = 0; j < 4; ++j) {
-      Eigen::Vector4d q = p;
-      const double h = j % 2 == 0 ? 0.05 : 0.2;
-      q[j] += h;
-      jac.col(j) = (residual(solver.settle(family(q, n), &state)) - res) / h;
-    }
-    bool improved = false;
-    for (int tries = 0; tries < 5 && !improved; ++tries) {
-      const Eigen::Matrix4d a = jac.transpose() * jac + lambda * Eigen::Matrix4d(jac.colwise().squaredNorm().asDiagonal());
-      const Eigen::Vector4d step = -a.ldlt().solve(jac.transpose() * res);
-      const auto trial = solver.settle(family(p + step, n), &state);
-      const auto trial_res = residual(trial);
-      if (trial_res.norm() < res.norm()) {
-        p += step;
-        res = trial_res;
-        result = trial;
-        state = solver.state();
-        lambda = std::max(1e-4, lambda * 0.3);
-        improved = true;
-      } else {
-        lambda *= 10;
-      }
-    }
-    if (!improved) break;
-  }
-  error = res.head<3>().norm();
-  return p;
 }
 
 // ---- 2. workspace map -----------------------------------------------------------------------
@@ -184,29 +134,23 @@ struct MapResult {
 };
 
 
-/// A grasp-capable equilibrium found by the map.
-struct Sample {
-  Eigen::Vector4d p;
-  Vec3 grasp_center;
-  Vec3 tool_axis;
-};
-
 /// Random actuations of the script's family within the reach task's actuation limits (|tau| <=
 /// 150 N m bend per element; here at most 10 N m distributed and 150 N m at the tip in the
 /// vertical plane, 5 and 40 N m sideways), settled with the gripper's weight. A sample is
 /// grasp-capable when the arm (nodes, radius 5 cm) clears the top, the grasp centre is 2-20 cm
 /// above it and the tool axis within 45 degrees of straight down.
-MapResult map_workspace(const world::ArmMount& mount, int samples, std::vector<Sample>* capable) {
+MapResult map_workspace(const world::ArmMount& mount, int samples) {
   const world::TableDesc table = world::tabletop_table();
   const interaction::ParallelGripperParameters gp;
-  EquilibriumSolver solver(world::tabletop_arm_parameters(mount), gp.mass, gp.grasp_center().z());
+  EquilibriumSampler solver(world::tabletop_arm_parameters(mount), gp.mass, gp.grasp_center().z());
   MapResult m;
   m.hits.assign(std::size_t(m.grid_x * m.grid_y), 0);
   const double top = table.top_center.z();
   std::mt19937_64 rng(2024);
-  std::uniform_real_distribution<double> u(-1, 1);
+  auto u = [&] { return symmetric_uniform(rng); };
   for (int i = 0; i < samples; ++i) {
-    const Eigen::Vector4d p(5 * u(rng), 40 * u(rng), 10 * u(rng), 150 * u(rng));
+    const double a0 = 5 * u(), t0 = 40 * u(), a1 = 10 * u(), t1 = 150 * u();
+    const Eigen::Vector4d p(a0, t0, a1, t1);
     const auto r = solver.settle(family(p, solver.n_elements()));
     ++m.samples;
     if (!r.settled) continue;
@@ -219,7 +163,6 @@ MapResult map_workspace(const world::ArmMount& mount, int samples, std::vector<S
     const int iy = static_cast<int>(std::floor((g.y() - (table.top_center.y() - table.half_y)) / 0.1));
     if (ix < 0 || ix >= m.grid_x || iy < 0 || iy >= m.grid_y) continue;
     ++m.hits[std::size_t(ix * m.grid_y + iy)];
-    if (capable) capable->push_back({p, g, r.tool_axis});
   }
   return m;
 }
@@ -303,7 +246,7 @@ int main(int argc, char** argv) {
           world::ArmMount m;
           m.base_position.z() = world::tabletop_table().top_center.z() + h;
           m.pitch = pitch_deg * std::numbers::pi / 180;
-          const MapResult r = map_workspace(m, samples, nullptr);
+          const MapResult r = map_workspace(m, samples);
           const bool is_chosen = std::abs(m.base_position.z() - chosen.base_position.z()) < 1e-9 && std::abs(m.pitch - chosen.pitch) < 1e-9;
           std::printf("%20.2f  %11.0f  %7d  %9d  %19d%s\n", h, pitch_deg, r.settled, r.clear, r.covered(), is_chosen ? "   <- chosen" : "");
           std::fflush(stdout);
@@ -316,36 +259,26 @@ int main(int argc, char** argv) {
       write_pgm(chosen_map, pgm_path);
       std::printf("map image: %s\n\n", pgm_path.c_str());
     }
-    // ---- the script's actuations (equilibria of the chosen mount)
-    std::vector<Sample> capable;
-    map_workspace(chosen, samples, &capable);
-    if (capable.empty()) manisoft::detail::fail("no grasp-capable equilibrium found; raise --samples");
-    const Vec3 wish(0.5, 0.0, 0);
-    const Sample* best = &capable.front();
-    for (const auto& c : capable) {
-      const double score = (c.grasp_center - wish).head<2>().norm() - 0.2 * (-c.tool_axis.z());
-      const double best_score = (best->grasp_center - wish).head<2>().norm() - 0.2 * (-best->tool_axis.z());
-      if (score < best_score) best = &c;
-    }
+    // ---- the script's actuations: inverse statics of the chosen mount, within the limits
     const double top = world::tabletop_table().top_center.z();
     const interaction::ParallelGripperParameters gp;
-    EquilibriumSolver solver(world::tabletop_arm_parameters(chosen), gp.mass, gp.grasp_center().z());
-    const Eigen::Vector2d target_xy = best->grasp_center.head<2>();
+    const rod::RodParameters<double> arm = world::tabletop_arm_parameters(chosen);
+    const world::ArmWorldSettings settings;
+    rod::InverseStatics<double> statics(rod::make_arm_model(arm, gp.mass), {}, settings.limits);
+    const Eigen::Vector2d target_xy(0.5, 0.0);
     const Vec3 grasp_at(target_xy.x(), target_xy.y(), top + 0.045);  // fingertips 1 cm above the top
     const Vec3 above = grasp_at + Vec3(0, 0, 0.12);
-    const Vec3 carry = grasp_at + Vec3(-0.15, 0.0, 0.14);
-    const Vec3 place = grasp_at + Vec3(-0.15, 0.0, 0.006);
-    std::vector<Eigen::Vector4d> actuations{Eigen::Vector4d::Zero()};
-    Eigen::Vector4d p = best->p;
+    const Vec3 carry = grasp_at + Vec3(0.0, 0.15, 0.14);
+    const Vec3 place = grasp_at + Vec3(0.0, 0.15, 0.006);
+    std::vector<Array3> actuations{Array3::Zero(arm.n_elements, 3)};
     for (const Vec3& target : {above, grasp_at, carry, place}) {
-      double error = 0;
-      EquilibriumSolver::Result r;
-      rod::RodState<double> st = solver.state();
-      p = solve_actuation(solver, target, p, error, r, st);
-      std::printf("actuation for grasp centre (%.3f, %.3f, %.3f): a = (%.2f, %.2f) N m per element, tip (%.2f, %.2f) N m;"
-                  " equilibrium error %.1f mm, tool axis z %.3f\n", target.x(), target.y(), target.z(), p[0], p[2], p[1], p[3],
-                  error * 1e3, r.tool_axis.z());
-      actuations.push_back(p);
+      const auto r = statics.solve_cold(tool_down(target, gp));
+      if (!r.within_limits)
+        manisoft::detail::fail("no equilibrium within the actuation limits holds the gripper at (", target.transpose(),
+                               "): position error ", r.position_error, " m, torque ratio ", r.max_torque_ratio);
+      std::printf("grasp centre (%.3f, %.3f, %.3f): equilibrium error %.1e m, largest torque %.0f%% of its limit\n", target.x(),
+                  target.y(), target.z(), r.position_error, 100 * r.max_torque_ratio);
+      actuations.push_back(statics.feedforward());
     }
     // actuations: 0 rest, 1 above, 2 grasp, 3 carry, 4 place
     const std::vector<Phase> script{
@@ -353,8 +286,7 @@ int main(int argc, char** argv) {
         {"carry", 3, 0.8, 0.4, 1},    {"lower", 4, 0.6, 0.5, 1},   {"open", 4, 0.0, 0.3, 0}, {"retreat", 3, 0.6, 0.4, 0}};
 
     // ---- the world
-    world::ArmWorldSettings settings;
-    world::ArmWorld<Arm> world(Arm(world::tabletop_arm_parameters(chosen), kDt, rod::damping::AnalyticalLinear<double>(0.5)), settings);
+    world::ArmWorld<Arm> world(Arm(arm, kDt, rod::damping::AnalyticalLinear<double>(0.5)), settings);
     const std::vector<rigid::BodyId> objects = world::populate_tabletop(world, target_xy);
     const auto specs = world::tabletop_objects(top, target_xy);
     std::ofstream trace(out_path);
@@ -391,17 +323,17 @@ int main(int argc, char** argv) {
     };
     write_row(0);
     const double control_dt = kDt * settings.substeps_per_control_step;
-    Eigen::Vector4d current = actuations[0];
+    Array3 current = actuations[0];
     const Vec3 cube_start = world.rigid().position(objects[0]);
     double max_weld = 0;
     for (const auto& ph : script) {
-      const Eigen::Vector4d from = current, to = actuations[std::size_t(ph.target)];
+      const Array3 from = current, to = actuations[std::size_t(ph.target)];
       const int ramp = static_cast<int>(std::lround(ph.ramp / control_dt)), hold = static_cast<int>(std::lround(ph.hold / control_dt));
       for (int i = 0; i < ramp + hold; ++i) {
         const double a = ramp > 0 ? std::min(1.0, double(i + 1) / ramp) : 1.0;
         const double smooth = a * a * (3 - 2 * a);  // smoothstep: no torque jerk
         current = from + smooth * (to - from);
-        world.control_step(family(current, n), ph.s);
+        world.control_step(current, ph.s);
         ++control_step;
         max_weld = std::max(max_weld, world.gripper().weld_elastic_force());
         write_row(ph.s);

@@ -15,6 +15,7 @@
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/control/projected_executor.hpp"
 #include "manisoft/env/reach_env.hpp"
+#include "manisoft/env/rollout.hpp"
 #include "manisoft/rod.hpp"
 
 namespace {
@@ -40,18 +41,7 @@ Pose table_pose() {
 /// Runs one episode of `env` from `seed` with `executor` and returns the final info.
 template <typename Env, typename Executor>
 manisoft::env::ReachInfo run_episode(Env& env, Executor& executor, std::uint64_t seed) {
-  Array3 action = Array3::Zero(env.action_space().rows(), 3);
-  const auto* observation = &env.reset(seed);
-  executor.reset();
-  manisoft::env::ReachInfo info;
-  for (int t = 0; t < env.config().horizon; ++t) {
-    executor.act(*observation, action);
-    const auto result = env.step(action);
-    observation = &result.observation;
-    info = result.info;
-    if (result.done) break;
-  }
-  return info;
+  return manisoft::env::rollout(env, executor, seed).info;
 }
 
 std::string write_file(const std::string& name, const std::string& text) {
@@ -155,7 +145,7 @@ TEST_CASE("bad targets are refused", "[executor][input]") {
   control::Observation<double> o = env.reset(3);
   Array3 action = Array3::Zero(env.n_elements(), 3);
   o.target.translation.y() = std::numeric_limits<double>::infinity();
-  CHECK_THROWS_WITH(executor.act(o, action), Catch::Contains("target pose refused"));
+  CHECK_THROWS_WITH(executor.act(o, action), Catch::Contains("executor target: pose refused"));
   o = env.reset(3);
   o.node_indices[1] = 0;  // not ascending
   CHECK_THROWS_AS(executor.act(o, action), manisoft::Error);

@@ -184,9 +184,9 @@ TEST_CASE("the not-a-knot spline reproduces cubics and pins the muscle torque en
 
   // Muscle torques: 6 control points per direction, ends pinned to zero, scale 75.
   using Rod = manisoft::rod::CosseratRod<double, manisoft::rod::damping::None, manisoft::rod::bc::ClampedBase,
-                                    manisoft::rod::integrator::PositionVerlet, manisoft::rod::forcing::BsplineMuscleTorques>;
+                                    manisoft::rod::integrator::PositionVerlet, manisoft::rod::forcing::ElasticaRLMuscleTorques>;
   Rod rod(RodParameters<double>{}, 2e-4, manisoft::rod::damping::None<double>{});
-  auto& muscle = rod.forcing<manisoft::rod::forcing::BsplineMuscleTorques>();
+  auto& muscle = rod.forcing<manisoft::rod::forcing::ElasticaRLMuscleTorques>();
   Eigen::Matrix<double, 6, 3> activation;
   activation.setZero();
   activation(2, 0) = 1.0;   // normal direction, third control point (s = 3/7 m)
@@ -233,10 +233,10 @@ TEST_CASE("muscle torques bend a weightless rod until B kappa balances the muscl
   //   B kappa_k = sum_{j>k} tau_j(muscle) = T_{k+1} = profile(0, s_{k+1}),  s_{k+1} = (k + 2) L / n,
   // at the Voronoi point k between elements k and k+1 (s = (k + 1) L / n).
   using Rod = manisoft::rod::CosseratRod<double, manisoft::rod::damping::UniformExp, manisoft::rod::bc::ClampedBase,
-                                    manisoft::rod::integrator::PositionVerlet, manisoft::rod::forcing::BsplineMuscleTorques>;
+                                    manisoft::rod::integrator::PositionVerlet, manisoft::rod::forcing::ElasticaRLMuscleTorques>;
   const int n = 20;
   Rod rod(RodParameters<double>{}, 2e-4, manisoft::rod::damping::UniformExp<double>(20.0));
-  auto& muscle = rod.forcing<manisoft::rod::forcing::BsplineMuscleTorques>();
+  auto& muscle = rod.forcing<manisoft::rod::forcing::ElasticaRLMuscleTorques>();
   Eigen::Matrix<double, 6, 3> activation = Eigen::Matrix<double, 6, 3>::Zero();
   activation.col(0) << 0.2, 0.1, -0.1, -0.2, 0.05, 0.2;  // normal direction only, |T| <~ 15 N m
   muscle.set_control_points(activation);

@@ -18,7 +18,7 @@ using manisoft::rod::RodParameters;
 using FullRod = manisoft::rod::CosseratRod<double, manisoft::rod::damping::AnalyticalLinear, manisoft::rod::bc::ClampedBase,
                                       manisoft::rod::integrator::PositionVerlet, manisoft::rod::forcing::Gravity,
                                       manisoft::rod::forcing::UniformLabTorque, manisoft::rod::forcing::ElementTorques,
-                                      manisoft::rod::forcing::BsplineMuscleTorques, manisoft::rod::forcing::TipLoad>;
+                                      manisoft::rod::forcing::ElasticaRLMuscleTorques, manisoft::rod::forcing::TipLoad>;
 using SimpleRod = manisoft::rod::CosseratRod<double, manisoft::rod::damping::None, manisoft::rod::bc::ClampedBase,
                                         manisoft::rod::integrator::PositionVerlet, manisoft::rod::forcing::ElementTorques>;
 const double not_a_number = std::numeric_limits<double>::quiet_NaN();
@@ -73,7 +73,7 @@ TEST_CASE("non-finite torques and forces are refused and the state is kept", "[r
   CHECK_THROWS_WITH(rod.forcing<manisoft::rod::forcing::ElementTorques>().set(wrong_size), Contains("19 x 3"));
   Eigen::Matrix<double, 6, 3> activation = Eigen::Matrix<double, 6, 3>::Zero();
   activation(3, 1) = inf;
-  CHECK_THROWS_WITH(rod.forcing<manisoft::rod::forcing::BsplineMuscleTorques>().set_control_points(activation), Contains("(3, 1)"));
+  CHECK_THROWS_WITH(rod.forcing<manisoft::rod::forcing::ElasticaRLMuscleTorques>().set_control_points(activation), Contains("(3, 1)"));
   // A non-finite load that reaches the step (user force, tip load edited in place) is refused there.
   rod.state().external_forces(12, 1) = not_a_number;
   CHECK_THROWS_WITH(rod.step(), Contains("node 12") && Contains("step 50"));
@@ -122,7 +122,7 @@ TEST_CASE("a step allocates no heap memory once the rod is built", "[rod][alloc]
   for (int i = 0; i < 1000; ++i) {
     if (i % 7 == 0) {  // control updates at 714 Hz, as in the benchmark
       rod.forcing<manisoft::rod::forcing::ElementTorques>().set(torques);
-      rod.forcing<manisoft::rod::forcing::BsplineMuscleTorques>().set_control_points(activation);
+      rod.forcing<manisoft::rod::forcing::ElasticaRLMuscleTorques>().set_control_points(activation);
     }
     rod.state().external_forces(20, 2) += 0.01;
     rod.step();
@@ -137,7 +137,7 @@ TEST_CASE("identical inputs give bit-identical runs", "[rod][determinism]") {
     FullRod rod(RodParameters<double>{}, 2e-4, manisoft::rod::damping::AnalyticalLinear<double>(0.1));
     Eigen::Matrix<double, 6, 3> activation;
     for (int i = 0; i < 18; ++i) activation(i % 6, i / 6) = 0.05 * std::sin(1.3 * i);
-    rod.forcing<manisoft::rod::forcing::BsplineMuscleTorques>().set_control_points(activation);
+    rod.forcing<manisoft::rod::forcing::ElasticaRLMuscleTorques>().set_control_points(activation);
     rod.step(2000);
     return rod.state();
   };

@@ -13,6 +13,7 @@
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/control/projected_executor.hpp"
 #include "manisoft/env/reach_env.hpp"
+#include "manisoft/env/rollout.hpp"
 #include "manisoft/world/arm_world.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
 
@@ -94,22 +95,13 @@ namespace {
 /// target's inverse statics) and the first control step (the world sizes its buffers).
 template <typename Env, typename Executor>
 long episode_allocations(Env& env, Executor& executor, std::uint64_t seed, bool& success) {
-  Torques action = Torques::Zero(env.action_space().rows(), 3);
-  const auto* observation = &env.reset(seed);
-  executor.reset();
-  executor.act(*observation, action);
-  observation = &env.step(action).observation;
-  executor.act(*observation, action);
-  const long before = allocation_count.load();
-  bool done = false;
-  while (!done) {
-    const auto result = env.step(action);
-    observation = &result.observation;
-    done = result.done;
-    success = result.info.success;
-    if (!done) executor.act(*observation, action);
-  }
-  return allocation_count.load() - before;
+  long start = 0, end = 0;
+  const auto record = manisoft::env::rollout(env, executor, seed, [&](const auto& step) {
+    if (step.step == 0) start = allocation_count.load();
+    if (step.result.done) end = allocation_count.load();
+  });
+  success = record.info.success;
+  return end - start;
 }
 
 }  // namespace

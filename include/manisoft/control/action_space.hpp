@@ -14,7 +14,7 @@
 //                        is sum_{j >= k} tau_j = scale T(s_k): at equilibrium the muscle profile
 //                        is the bending/twisting couple the arm holds there. (Elastica-RL
 //                        evaluates T one element further out, at s = (k + 1) l0, on current
-//                        lengths; forcing::BsplineMuscleTorques keeps that rule.) Knots:
+//                        lengths; forcing::ElasticaRLMuscleTorques keeps that rule.) Knots:
 //                        `pinned_ends` (Elastica-RL) puts K interior knots in
 //                        linspace(0, L, K + 2) with zero end values;
 //                        otherwise K knots span linspace(0, L, K) and every value is free (a tip
@@ -22,11 +22,12 @@
 //
 // Interface, both classes:
 //   rows()                         rows of an action (3 columns always);
-//   apply(action, torques) -> int  writes the element torques, each clamped to the actuation
-//                                  limits (|tau_1|, |tau_2| <= bend, |tau_3| <= twist; element 0
-//                                  is clamped by the boundary condition and gets 0); returns the
-//                                  number of clamped entries. A non-finite action entry is
-//                                  refused naming its (row, column); nothing is written then.
+//   apply(action, torques)         writes the element torques the action asks for. The actuation
+//                                  limits are applied where every action enters the arm, the arm
+//                                  world's control step (world::ArmWorld::control_step through
+//                                  rod::clamp_to_limits); limits() reports them. A non-finite
+//                                  action entry is refused naming its (row, column); nothing is
+//                                  written then.
 //   project(torques, action)       the action whose (unclamped) element torques reproduce
 //                                  `torques` best: the identity for element torques, the least-
 //                                  squares fit of the carried couples sum_{j >= k} tau_j
@@ -52,7 +53,7 @@ concept ActionSpace = requires(const T& space, const Eigen::Matrix<typename T::S
                                Eigen::Matrix<typename T::Scalar, Eigen::Dynamic, 3>& out) {
   { space.rows() } -> std::same_as<int>;
   { space.n_elements() } -> std::same_as<int>;
-  { space.apply(in, out) } -> std::same_as<int>;
+  { space.apply(in, out) } -> std::same_as<void>;
   { space.project(in, out) } -> std::same_as<void>;
 };
 
@@ -96,12 +97,11 @@ class ElementTorqueAction {
   int n_elements() const { return n_elements_; }
   const rod::ActuationLimits<Scalar>& limits() const { return limits_; }
 
-  int apply(const Array3& action, Array3& torques) const {
+  void apply(const Array3& action, Array3& torques) const {
     action_detail::require_shape("ElementTorqueAction action", action, n_elements_);
     action_detail::require_finite_action("ElementTorqueAction", action);
     action_detail::require_shape("ElementTorqueAction torques", torques, n_elements_);
     torques = action;
-    return rod::clamp_to_limits(limits_, torques);
   }
 
   void project(const Array3& torques, Array3& action) const {
@@ -159,14 +159,13 @@ class BsplineMuscleAction {
   /// node k), columns = control points.
   const Matrix& couple_basis() const { return basis_; }
 
-  int apply(const Array3& action, Array3& torques) const {
+  void apply(const Array3& action, Array3& torques) const {
     action_detail::require_shape("BsplineMuscleAction action", action, rows());
     action_detail::require_finite_action("BsplineMuscleAction", action);
     action_detail::require_shape("BsplineMuscleAction torques", torques, n_elements_);
     couples_.noalias() = basis_ * action;
     for (int k = 0; k + 1 < n_elements_; ++k) torques.row(k) = couples_.row(k) - couples_.row(k + 1);
     torques.row(n_elements_ - 1) = couples_.row(n_elements_ - 1);
-    return rod::clamp_to_limits(limits_, torques);
   }
 
   void project(const Array3& torques, Array3& action) const {

@@ -39,11 +39,7 @@ concept Executor = requires { typename T::Scalar; } &&
 /// Refuses a non-finite or non-rotation target and a malformed observation (manisoft::Error).
 template <typename Scalar>
 void validate_observation(const Observation<Scalar>& o, int n_nodes) {
-  if (!o.target.is_finite())
-    manisoft::detail::fail("executor: target pose refused, it is not finite (translation = ", o.target.translation.transpose(), ")");
-  const Scalar orthogonality = (o.target.rotation * o.target.rotation.transpose() - Eigen::Matrix<Scalar, 3, 3>::Identity()).norm();
-  if (orthogonality > Scalar(1e-6) || o.target.rotation.determinant() < 0)
-    manisoft::detail::fail("executor: target pose refused, its rotation is not a rotation matrix (|R R^T - I| = ", orthogonality, ")");
+  math::require_valid_pose(o.target, "executor target");
   const auto m = o.node_indices.size();
   if (m < 2 || o.node_positions.rows() != m || o.node_velocities.rows() != m)
     manisoft::detail::fail("executor: observation needs >= 2 observed nodes with one position and one velocity row each (got ",

@@ -18,8 +18,8 @@
 //   end-effector rotation column-major (9), observed node positions (m x 3, node by node),
 //   observed node velocities (m x 3, node by node).
 // Output: the action, rows x 3 (row-major: row r's d1, d2, d3; rows = the action space's rows:
-// n element torques in N m, or K B-spline control values), passed on unclamped: the action
-// space of the environment applies the actuation limits. A non-finite output is refused naming
+// n element torques in N m, or K B-spline control values), passed on unclamped: the
+// arm world's control step applies the actuation limits. A non-finite output is refused naming
 // its index (a policy that emits NaN is an error, not a zero torque). act() does not allocate.
 #pragma once
 

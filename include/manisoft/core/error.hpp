@@ -1,4 +1,8 @@
-// ManiSoft error reporting: one exception type for every refused input or diverged state.
+// ManiSoft error reporting, by kind: InvalidInput (a parameter, action, file or call the library
+// refuses before changing anything) and Diverged (a simulation step that produced a non-finite
+// or diverging state: the simulation keeps its state from before that step). Both derive from
+// Error, so `catch (const Error&)` still sees everything; an environment that must go on after a
+// blown-up step catches Diverged only and lets programming errors through.
 // Messages name the offending value, the limit it broke and, where it applies, the element or
 // step, so a user can fix the call without reading our code.
 #pragma once
@@ -11,22 +15,55 @@
 
 namespace manisoft {
 
-/// Thrown for invalid parameters, malformed input files, unstable time steps and non-finite
-/// states. The object that threw keeps its last valid state.
+/// Base of every ManiSoft exception. The object that threw keeps its last valid state.
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
 
+/// Invalid parameters, malformed files, unstable time steps, non-finite actions or loads, calls
+/// out of order: refused before anything changed.
+class InvalidInput : public Error {
+ public:
+  using Error::Error;
+};
+
+/// A simulation step produced a non-finite or diverging state; the simulation was put back to
+/// its state before that step. `step` is the step that failed; `where` names the rod node or
+/// element, or the rigid body ("element 7", "body 3 ('cube')").
+class Diverged : public Error {
+ public:
+  Diverged(const std::string& message, long step, std::string where)
+      : Error(message), step_(step), where_(std::move(where)) {}
+  long step() const { return step_; }
+  const std::string& where() const { return where_; }
+
+ private:
+  long step_;
+  std::string where_;
+};
+
 namespace detail {
 
-/// Builds an Error message from streamable parts: fail("youngs_modulus = ", E, " must be > 0").
 template <typename... Parts>
-[[noreturn]] void fail(Parts&&... parts) {
+std::string message(Parts&&... parts) {
   std::ostringstream out;
   out.precision(17);
   (out << ... << std::forward<Parts>(parts));
-  throw Error(out.str());
+  return out.str();
+}
+
+/// Refuses an input: throws InvalidInput built from streamable parts:
+/// fail("youngs_modulus = ", E, " must be > 0").
+template <typename... Parts>
+[[noreturn]] void fail(Parts&&... parts) {
+  throw InvalidInput(message(std::forward<Parts>(parts)...));
+}
+
+/// Reports a diverged step (`step`, at `where`): throws Diverged built from streamable parts.
+template <typename... Parts>
+[[noreturn]] void diverged(long step, const std::string& where, Parts&&... parts) {
+  throw Diverged(message(std::forward<Parts>(parts)...), step, where);
 }
 
 /// Refuses a parameter that is not finite or not strictly positive.

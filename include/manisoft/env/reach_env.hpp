@@ -1,51 +1,40 @@
-// ReachEnv: the executor benchmark environment of issue 4 (paper section 3.4 and appendix):
-// reach a target end-effector SE(3) pose with the soft arm and hold it.
+// ReachEnv: the executor benchmark environment (ManiSoft paper, section 3.4 and appendix): reach
+// a target end-effector SE(3) pose with the soft arm and hold it.
 //
 //   env.reset(seed) -> observation;  env.step(action) -> {observation, reward, done, info}
 //
-// Arm (paper "Key Parameters", DESIGN.md 3): n = 20, L = 1 m, r = 0.05 m, rho = 1000, E = 1e7,
-// G = E/3, base clamped at the origin with d3 = +x (horizontal), d1 = +z, gravity -z,
-// dt = 2e-4 s, PositionVerlet, 7 substeps per control step (714 Hz), horizon 1500 control steps.
-// End-effector: the full arm of the world issue: the parallel gripper (world/gripper.hpp, a rigid
-// compound body, 0.2 kg) on the elastic spring coupling (coupling/elastic_spring.hpp; see
-// ReachEnvConfig::coupling) to the rod tip, in a SoftArmWorld with gravity. The end-effector pose is the gripper's
-// attachment frame (the centre of the palm's top face, axes = the tip's directors when aligned).
-// A held load (`load_mass`) rides in the closed gripper: it is added to the gripper body's mass.
-// `model_error` F makes the simulated Young's modulus (1 + F) times the nominal one; the
-// nominal model (nominal_model()) is what an executor should assume: nominal E, gripper only.
-// Action: a policy class (control/action_space.hpp), the template parameter ActionPolicy:
-// ElementTorqueAction (n x 3 material-frame element torques, the default) or
-// BsplineMuscleAction (K x 3 control values of a muscle couple profile). Either way the element
-// torques are clamped to the actuation limits (ActuationLimits: |tau_1|, |tau_2| <= 150 N m,
-// |tau_3| <= 75 N m; element 0 is clamped and takes no torque); info.clipped counts the clamped
-// entries. The limits are set by what the inverse statics needs: a shape with tip curvature
-// kappa(L) must be held by the tip element's couple B kappa(L) (B = EI = 49 N m^2).
-// Observation: target, end-effector pose, positions and velocities of every
-// `observe_stride`-th node (always including the tip).
-// Reward: R = R_d + R_s of the paper (d = |d_p| + 0.2 |d_r|; R_d with k1 = 0.5, k2 = 1.5,
-// d1 = 0.1, d2 = 0.05; R_s with beta = 1, D = 0.3). info reports the pose error, whether it is
-// within tolerance, and the success of the episode: within tolerance, then held for
-// `hold_steps` control steps (first_success_step is the first step of that held window).
+// The arm is the benchmark's arm world (world::ArmWorld, world frame of world/tabletop_scene.hpp:
+// floor z = 0, table plane z = 0.75, base at (-0.05, 0, 1.5) pointing +x): the paper's rod (n = 20,
+// L = 1 m, r = 0.05 m, rho = 1000, E = 1e7, G = E/3), dt = 2e-4 s, 7 substeps per control step
+// (714 Hz), horizon 1500, the parallel gripper on the arm world's coupling; configured without a
+// table and without rod contact (free space). A held load (`load_mass`) rides in the closed
+// gripper: it is added to the gripper body's mass. `model_error` F makes the simulated Young's
+// modulus (1 + F) times the nominal one; nominal_model() is what an executor should assume.
+// Action: a policy class (control/action_space.hpp), ElementTorqueAction (n x 3 material-frame
+// element torques, the default) or BsplineMuscleAction (K x 3 muscle control values); the arm
+// world's control step clamps the element torques to the actuation limits (|tau_1|, |tau_2| <=
+// 150 N m, |tau_3| <= 75 N m; element 0 takes none); info.clipped counts the clamped entries.
+// Observation: target, end-effector pose (the gripper's attachment frame: centre of the palm's
+// top face), positions and velocities of every `observe_stride`-th node (always the tip).
+// Reward: R = R_d + R_s of the paper (d = |d_p| + 0.2 |d_r|; k1 = 0.5, k2 = 1.5, d1 = 0.1,
+// d2 = 0.05; beta = 1, D = 0.3). Success: within tolerance, then held for `hold_steps` control
+// steps (first_success_step is the first step of that held window). A diverged simulation step
+// ends the episode (info.diverged; the world keeps its state before the step); invalid input
+// (a malformed action) is refused with manisoft::InvalidInput and changes nothing.
 //
-// Target sets (seeded; every target is reachable at equilibrium by the nominal model within
-// the actuation limits, checked with the inverse statics, else redrawn):
-//   table       the gripper above a table top, pointing down: position uniform in
-//               x in [0.40, 0.85], y in [-0.25, 0.25], z in [-0.70, -0.30] m (table plane
-//               z = -0.75 m, the arm's base 0.75 m above it), tool axis d3 within 45 deg of -z
-//               (uniform on the cap), any yaw. Measured with the quadratic-curvature inverse
-//               statics (2000 candidates): 50% are held within the limits and kept; the other
-//               half is redrawn: 21% have no shape at all (7.5% of the box lies beyond the 1 m
-//               arm's reach, |p| > 1 m, more is too close to full extension for the tip to point
-//               down), 29% need more torque than the limits. Acceptance by region: far and low
-//               (x > 0.70, z < -0.57) 7%, near (x < 0.55) 61-70%; tool tilt 0-15 deg 62%,
-//               30-45 deg 47%. Kept targets: tip axis bent 46-133 deg from the base axis (median
-//               85), total twist up to 244 deg (median 80), bend curvature up to 12 1/m.
+// Target sets (seeded; every target is held at equilibrium by the nominal model within the
+// actuation limits, checked with the inverse statics, else redrawn), relative to the arm's base:
+//   table       the gripper above the table plane, pointing down: position uniform in
+//               x in [0.40, 0.85], y in [-0.25, 0.25], z in [-0.70, -0.30] m from the base (the
+//               table plane is 0.75 m below it), tool axis d3 within 45 deg of -z (uniform on the
+//               cap), any yaw.
 //   equilibria  tip poses where the arm settles under random bounded actuation: per axis a
-//               random quadratic torque profile along the arm (|tau| <= 10 N m bend,
-//               4 N m twist) plus a random tip-element couple (<= 60 N m bend, 20 N m twist),
-//               settled with heavy uniform damping; actuations that do not settle within 4 s
+//               random quadratic torque profile along the arm (|tau| <= 10 N m bend, 4 N m
+//               twist) plus a random tip-element couple (<= 60 N m bend, 20 N m twist), settled
+//               with heavy uniform damping; actuations that do not settle within 4 s
 //               (follower-torque flutter) or whose pose the inverse statics cannot hold within
 //               the limits are redrawn.
+// BENCHMARKS.md ("Executor") has the measured acceptance rates of both sets.
 #pragma once
 
 #include <Eigen/Core>
@@ -60,15 +49,16 @@
 
 #include "manisoft/control/action_space.hpp"
 #include "manisoft/control/executor.hpp"
-#include "manisoft/rod/inverse_statics.hpp"
 #include "manisoft/core/error.hpp"
 #include "manisoft/reward/distance_reward.hpp"
 #include "manisoft/reward/pose_distance.hpp"
 #include "manisoft/reward/stability_reward.hpp"
 #include "manisoft/reward/sum.hpp"
 #include "manisoft/rod/cosserat_rod.hpp"
-#include "manisoft/interaction/gripper.hpp"
-#include "manisoft/world/soft_arm_world.hpp"
+#include "manisoft/rod/inverse_statics.hpp"
+#include "manisoft/rod/settle.hpp"
+#include "manisoft/world/arm_world.hpp"
+#include "manisoft/world/tabletop_scene.hpp"
 
 namespace manisoft::env {
 
@@ -81,21 +71,12 @@ inline TargetSet parse_target_set(const std::string& name) {
 }
 
 struct ReachEnvConfig {
-  rod::RodParameters<double> rod{};              ///< nominal arm (defaults: the paper's)
+  rod::RodParameters<double> rod = world::tabletop_arm_parameters();  ///< nominal arm, mounted in the world frame
   double dt = 2e-4;                         ///< s
   int substeps = 7;                         ///< simulation steps per control step (714 Hz)
   int horizon = 1500;                       ///< control steps per episode
   double gripper_mass = 0.2;                ///< kg, known to the executor's model
-  /// Rod tip <-> gripper spring. The stiff preset with a 10x stiffer rotational spring: the
-  /// executor drives the tip element with up to 150 N m, and with kM = 100 N m/rad a gripper
-  /// carrying a 0.3 kg load twisted 0.3 rad off the tip and the pair went unstable (reach_eval
-  /// --load-kg 0.3: 1-18 % success); with kM = 1000 it holds (omega dt = 0.4 on the tip element).
-  interaction::ElasticSpringParameters coupling = [] {
-    auto p = interaction::ElasticSpringParameters::stiff();
-    p.rotational_stiffness = 1000;
-    p.rotational_damping = 0.6;
-    return p;
-  }();
+  interaction::ElasticSpringParameters coupling = interaction::ElasticSpringParameters::arm();  ///< rod tip <-> gripper
   double load_mass = 0;                     ///< kg, held load unknown to the model
   double model_error = 0;                   ///< F: simulated E = (1 + F) E_nominal
   int observe_stride = 2;                   ///< observe every k-th node (and the tip)
@@ -125,7 +106,8 @@ class ReachEnv {
   static_assert(control::ActionSpace<Action>);
   using Rod = rod::CosseratRod<double, Damping, rod::bc::ClampedBase, rod::integrator::PositionVerlet, rod::forcing::Gravity,
                           rod::forcing::ElementTorques>;
-  using World = world::SoftArmWorld<Rod>;
+  using World = world::ArmWorld<Rod>;
+  using Info = ReachInfo;
   using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
   using Pose = math::Pose<double>;
   using Reward = reward::Sum<reward::DistanceReward<double>, reward::StabilityReward<double>>;
@@ -180,10 +162,13 @@ class ReachEnv {
     rod::RodParameters<double> sim = config_.rod;
     sim.youngs_modulus *= 1 + config_.model_error;
     if (config_.rod.shear_modulus > 0) sim.shear_modulus *= 1 + config_.model_error;
-    interaction::ParallelGripperParameters gripper;
-    gripper.mass = config_.gripper_mass + config_.load_mass;
-    world_.emplace(Rod(sim, config_.dt, damping_), rigid::RigidWorldSettings{}, interaction::make_parallel_gripper(gripper),
-                   interaction::ElasticSpring(config_.coupling));
+    world::ArmWorldSettings settings;
+    settings.gripper.mass = config_.gripper_mass + config_.load_mass;
+    settings.coupling = config_.coupling;
+    settings.rod_contact_enabled = false;
+    settings.limits = config_.limits;
+    settings.substeps_per_control_step = config_.substeps;
+    world_.emplace(Rod(sim, config_.dt, damping_), settings);
     reward_ = Reward{};
     info_ = ReachInfo{};
     held_ = 0;
@@ -196,17 +181,12 @@ class ReachEnv {
   /// one control step. A malformed or non-finite action is refused before anything changes.
   StepResult step(const Array3& action) {
     if (!world_) manisoft::detail::fail("ReachEnv::step called before reset");
-    info_.clipped = action_space_.apply(action, element_torques_);
-    world_->rod().template forcing<rod::forcing::ElementTorques>().set(element_torques_);
+    action_space_.apply(action, element_torques_);
+    info_.clipped = 0;
     if (!info_.diverged) {
       try {
-        for (int s = 0; s < config_.substeps; ++s) {
-          world_->step();
-          const double d = reward::pose_error(end_effector(), target_).distance;
-          d_history_[d_count_ % config_.stability_window] = d;
-          ++d_count_;
-        }
-      } catch (const Error&) {
+        info_.clipped = world_->control_step(element_torques_, 0, [this] { record_distance(); });
+      } catch (const Diverged&) {
         info_.diverged = true;
       }
     }
@@ -230,6 +210,8 @@ class ReachEnv {
   const Pose& target() const { return target_; }
   const ReachInfo& info() const { return info_; }
   const Rod& rod() const { return world_->rod(); }
+  /// The tabletop world's arm frame: where the target sets are drawn from.
+  const Eigen::Vector3d& base_position() const { return config_.rod.base_position; }
   const World& world() const { return *world_; }
   /// Variance of d over the last stability_window simulation steps (fewer if not yet run).
   double stability_variance() const {
@@ -265,7 +247,8 @@ class ReachEnv {
 
   std::optional<Pose> table_candidate(std::mt19937_64& rng) const {
     const double pi = std::numbers::pi;
-    const Eigen::Vector3d p(uniform(rng, 0.40, 0.85), uniform(rng, -0.25, 0.25), uniform(rng, -0.70, -0.30));
+    const Eigen::Vector3d p = config_.rod.base_position +
+                              Eigen::Vector3d(uniform(rng, 0.40, 0.85), uniform(rng, -0.25, 0.25), uniform(rng, -0.70, -0.30));
     const double yaw = uniform(rng, -pi, pi);
     const double tilt = std::acos(1 - uniform(rng, 0, 1) * (1 - std::cos(pi / 4)));
     const double tilt_dir = uniform(rng, 0, 2 * pi);
@@ -277,8 +260,6 @@ class ReachEnv {
   }
 
   std::optional<Pose> equilibrium_candidate(std::mt19937_64& rng) const {
-    using SettleRod = rod::CosseratRod<double, rod::damping::UniformExp, rod::bc::ClampedBase, rod::integrator::PositionVerlet, rod::forcing::Gravity,
-                                  rod::forcing::ElementTorques, rod::forcing::TipLoad>;
     const int n = n_elements();
     Array3 torques = Array3::Zero(n, 3);
     for (int c = 0; c < 3; ++c) {
@@ -296,24 +277,25 @@ class ReachEnv {
     }
     rod::forcing::TipLoad<double> tip;
     tip.force_lab = rod::forcing::Gravity<double>{}.acceleration * config_.gripper_mass;
-    SettleRod rod(config_.rod, config_.dt, rod::damping::UniformExp<double>(20.0), rod::forcing::Gravity<double>{},
-                  rod::forcing::ElementTorques<double>{}, tip);
+    rod::SettlingRod<double> rod(config_.rod, config_.dt, rod::damping::UniformExp<double>(20.0), rod::forcing::Gravity<double>{},
+                                 rod::forcing::ElementTorques<double>{}, tip);
     rod.template forcing<rod::forcing::ElementTorques>().set(torques);
-    const int steps = static_cast<int>(std::lround(4.0 / config_.dt));
-    try {
-      for (int i = 0; i < steps; ++i) rod.step();
-    } catch (const Error&) {
-      return std::nullopt;
-    }
-    const double speed = rod.state().velocities.rowwise().norm().maxCoeff();
-    const double spin = rod.state().angular_velocities.rowwise().norm().maxCoeff();
-    if (!(speed < 1e-4 && spin < 1e-3)) return std::nullopt;
-    return Pose{rod.state().director(n - 1).transpose(), rod.state().tip_position()};
+    rod::SettleCriteria<double> rest;  // 4 s, then at rest or redrawn
+    rest.min_time = rest.max_time = 4.0;
+    rest.speed = 1e-4;
+    rest.spin = 1e-3;
+    if (!rod::settle(rod, rest)) return std::nullopt;
+    return rod.state().tip_pose();
   }
 
   Pose end_effector() const {
-    const auto frame = world_->end_effector_frame();
+    const auto frame = world_->soft().end_effector_frame();
     return Pose{frame.rotation, frame.position};
+  }
+
+  void record_distance() {
+    d_history_[d_count_ % config_.stability_window] = reward::pose_error(end_effector(), target_).distance;
+    ++d_count_;
   }
 
   void fill_observation() {

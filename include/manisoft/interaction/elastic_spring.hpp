@@ -7,17 +7,16 @@
 // x_b, R_b: the body's attachment frame. Without damping F is central (along x_b - x_t), so the
 // pair conserves linear and angular momentum; the damping terms conserve linear momentum only.
 //
-// Stiffness choice. The paper prints kF = 0.1 N/m and kM = 10 N m/rad (preset `paper()`): under
-// gravity a 0.2 kg gripper would hang m g / kF = 19.6 m below the tip, i.e. it does not hold an
-// end-effector at all. The default `stiff()` preset holds the gripper (0.2 kg) plus the heaviest
-// benchmark object (0.5 kg) with m g / kF = 0.34 mm and, for a 5 cm lever, 0.34 N m / kM =
-// 0.2 degrees, while staying stable at dt = 2e-4 s: the stiffest mode, kF against the rod tip
-// node (0.196 kg) in series with the gripper, has omega dt = sqrt(kF (1/m_tip + 1/m_g)) dt = 0.09,
-// and the rotational one, kM against the tip element's bending inertia (2.5e-4 kg m^2),
-// omega dt = 0.13, both far below the leapfrog limit of 2. Translational damping is 20 % of
-// critical on the gripper mass; rotational damping 0.3 N m s/rad is about 60 % of critical for the
-// 0.2 kg gripper (cM dt / J_tip = 0.24, explicit-stable): with 0.05 (11 %) the gripper body
-// spun off the tip under the reach executor's twist feedback when it carried a load.
+// Presets. The paper prints kF = 0.1 N/m and kM = 10 N m/rad (`paper()`): under gravity a 0.2 kg
+// gripper would hang m g / kF = 19.6 m below the tip, i.e. it does not hold an end-effector.
+// `stiff()` holds the gripper (0.2 kg) plus a 0.5 kg object at m g / kF = 0.34 mm and, on a 5 cm
+// lever, 0.34 N m / kM = 0.2 degrees, explicit-stable at dt = 2e-4 s: the stiffest translational
+// mode (kF against the tip node, 0.196 kg, in series with the gripper) has omega dt = 0.09, the
+// rotational one (kM against the tip element's bending inertia, 2.5e-4 kg m^2) omega dt = 0.13.
+// `arm()`, the arm world's default, is stiff() with kM = 1000 N m/rad (omega dt = 0.4) and
+// cM = 0.6 N m s/rad: the executor drives the tip element with up to 150 N m, and a gripper
+// carrying a load must follow the tip's rotation closely (BENCHMARKS.md, "Executor", has the
+// runs behind the choice).
 #pragma once
 
 #include <Eigen/Core>
@@ -35,8 +34,10 @@ struct ElasticSpringParameters {
 
   /// The values printed in the paper's parameter table (they cannot carry a gripper's weight).
   static ElasticSpringParameters paper() { return {0.1, 10, 0, 0}; }
-  /// Our default (see the header comment): separation < 1 mm and < 1 degree at 0.7 kg.
+  /// Separation < 1 mm and < 1 degree at 0.7 kg (see the header comment).
   static ElasticSpringParameters stiff() { return {}; }
+  /// The arm world's default: stiff() with a 10x stiffer, more damped rotational spring.
+  static ElasticSpringParameters arm() { return {2e4, 1000, 25, 0.6}; }
 
   void validate() const {
     manisoft::detail::require_positive("ElasticSpring translational_stiffness", translational_stiffness);

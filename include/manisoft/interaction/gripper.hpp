@@ -43,6 +43,7 @@
 #include "manisoft/math/so3.hpp"
 #include "manisoft/rigid/rigid_world.hpp"
 #include "manisoft/interaction/end_effector.hpp"
+#include "manisoft/interaction/stable_spring.hpp"
 
 namespace manisoft::interaction {
 
@@ -123,6 +124,23 @@ class ParallelGripper {
   using Vec3 = Eigen::Vector3d;
   using Mat3 = Eigen::Matrix3d;
 
+  /// Everything a world step changes in the gripper: command and state S, the held object and
+  /// its weld (anchor, stiffnesses), the last step's weld wrench and events. A plain value: a
+  /// world's rollback copies it whole.
+  struct Snapshot {
+    int command = 0, state = 0;
+    std::optional<rigid::BodyId> held, last_released;
+    double held_width = 0;
+    Vec3 anchor_local = Vec3::Zero();
+    Mat3 rotation_local = Mat3::Identity();
+    double k = 0, k_r = 0, c = 0, c_r = 0;
+    Vec3 weld_force = Vec3::Zero(), weld_torque = Vec3::Zero();
+    double elastic_force = 0;
+    bool grasped_now = false, released_now = false, slipped = false;
+  };
+  void save(Snapshot& out) const { out = m_; }
+  void restore(const Snapshot& in) { m_ = in; }
+
   ParallelGripper() : ParallelGripper(ParallelGripperParameters{}) {}
   explicit ParallelGripper(const ParallelGripperParameters& p) : params_(p) {
     params_.validate();
@@ -137,23 +155,23 @@ class ParallelGripper {
   /// Commands S (0 open, 1 closed); takes effect at the next pre_step.
   void command(int s) {
     if (s != 0 && s != 1) manisoft::detail::fail("ParallelGripper::command: S = ", s, " must be 0 (open) or 1 (closed)");
-    command_ = s;
+    m_.command = s;
   }
-  int command_state() const { return command_; }
+  int command_state() const { return m_.command; }
   /// The state S the gripper is in (after the last pre_step).
-  int state() const { return state_; }
-  std::optional<rigid::BodyId> held() const { return held_; }
+  int state() const { return m_.state; }
+  std::optional<rigid::BodyId> held() const { return m_.held; }
   /// Visible distance between the fingers [m] (see the header comment).
-  double finger_width() const { return state_ == 0 ? params_.open_width : (held_ ? held_width_ : 0.0); }
+  double finger_width() const { return m_.state == 0 ? params_.open_width : (m_.held ? m_.held_width : 0.0); }
   /// The weld wrench on the held object in the last step (lab) and its elastic parts.
-  const Vec3& weld_force() const { return weld_force_; }
-  const Vec3& weld_torque() const { return weld_torque_; }
-  double weld_elastic_force() const { return elastic_force_; }
+  const Vec3& weld_force() const { return m_.weld_force; }
+  const Vec3& weld_torque() const { return m_.weld_torque; }
+  double weld_elastic_force() const { return m_.elastic_force; }
   /// Events of the last pre_step.
-  bool grasped_now() const { return grasped_now_; }
-  bool released_now() const { return released_now_; }
-  bool slipped() const { return slipped_; }
-  std::optional<rigid::BodyId> last_released() const { return last_released_; }
+  bool grasped_now() const { return m_.grasped_now; }
+  bool released_now() const { return m_.released_now; }
+  bool slipped() const { return m_.slipped; }
+  std::optional<rigid::BodyId> last_released() const { return m_.last_released; }
 
   /// World pose of the grasp region centre.
   Vec3 grasp_point(const rigid::RigidWorld& world) const {
@@ -188,26 +206,26 @@ class ParallelGripper {
 
   /// Before each world step: handles S transitions, applies the weld wrench, checks slip.
   void pre_step(rigid::RigidWorld& world, double dt) {
-    grasped_now_ = released_now_ = slipped_ = false;
-    weld_force_.setZero();
-    weld_torque_.setZero();
-    elastic_force_ = 0;
-    if (command_ != state_) {
-      state_ = command_;
-      if (state_ == 1) {
+    m_.grasped_now = m_.released_now = m_.slipped = false;
+    m_.weld_force.setZero();
+    m_.weld_torque.setZero();
+    m_.elastic_force = 0;
+    if (m_.command != m_.state) {
+      m_.state = m_.command;
+      if (m_.state == 1) {
         if (auto b = find_graspable(world)) start_weld(world, *b, dt);
-      } else if (held_) {
+      } else if (m_.held) {
         release();
       }
     }
-    if (held_) apply_weld(world);
+    if (m_.held) apply_weld(world);
   }
 
  private:
   void release() {
-    last_released_ = held_;
-    held_.reset();
-    released_now_ = true;
+    m_.last_released = m_.held;
+    m_.held.reset();
+    m_.released_now = true;
   }
 
   static double smallest_inertia(const rigid::RigidBodyModel& m) {
@@ -216,13 +234,13 @@ class ParallelGripper {
   }
 
   void start_weld(rigid::RigidWorld& world, rigid::BodyId b, double dt) {
-    held_ = b;
-    grasped_now_ = true;
+    m_.held = b;
+    m_.grasped_now = true;
     const Mat3 rg = world.orientation(body_).toRotationMatrix();
     const Vec3 xg = world.position(body_);
     const Vec3 xo = world.center_of_mass(b);
-    anchor_local_ = rg.transpose() * (xo - xg);
-    rotation_local_ = rg.transpose() * world.orientation(b).toRotationMatrix();
+    m_.anchor_local = rg.transpose() * (xo - xg);
+    m_.rotation_local = rg.transpose() * world.orientation(b).toRotationMatrix();
     // Visible width: the object's extent along the closing axis inside the open fingers.
     double lo = INFINITY, hi = -INFINITY;
     const auto& m = world.model(b);
@@ -237,42 +255,41 @@ class ParallelGripper {
       hi = std::max(hi, ghi.x());
     }
     const double half = 0.5 * params_.open_width;
-    held_width_ = std::max(0.0, std::min(hi, half) - std::max(lo, -half));
+    m_.held_width = std::max(0.0, std::min(hi, half) - std::max(lo, -half));
     // Stiffness caps on the pair's reduced mass and inertia (the force acts at x_o, a lever
     // |x_o - x_g,com| on the gripper).
     const auto& mg = world.model(body_);
     const double lever2 = (xo - world.center_of_mass(body_)).squaredNorm();
     const double inv_m = m.inverse_mass + mg.inverse_mass + lever2 * mg.inverse_inertia.norm();
     const double inv_i = 1.0 / smallest_inertia(m) + 1.0 / smallest_inertia(mg);
-    const double w2 = (params_.max_omega_dt / dt) * (params_.max_omega_dt / dt);
-    k_ = std::min(params_.weld_stiffness, w2 / inv_m);
-    k_r_ = std::min(params_.weld_rotational_stiffness, w2 / inv_i);
-    c_ = 2 * params_.weld_damping_ratio * std::sqrt(k_ / inv_m);
-    c_r_ = 2 * params_.weld_damping_ratio * std::sqrt(k_r_ / inv_i);
+    m_.k = stable_stiffness(params_.weld_stiffness, 1.0 / inv_m, params_.max_omega_dt, dt);
+    m_.k_r = stable_stiffness(params_.weld_rotational_stiffness, 1.0 / inv_i, params_.max_omega_dt, dt);
+    m_.c = damping_for_ratio(params_.weld_damping_ratio, m_.k, 1.0 / inv_m);
+    m_.c_r = damping_for_ratio(params_.weld_damping_ratio, m_.k_r, 1.0 / inv_i);
   }
 
   void apply_weld(rigid::RigidWorld& world) {
-    const rigid::BodyId b = *held_;
+    const rigid::BodyId b = *m_.held;
     const Mat3 rg = world.orientation(body_).toRotationMatrix();
-    const Vec3 xa = world.position(body_) + rg * anchor_local_;
+    const Vec3 xa = world.position(body_) + rg * m_.anchor_local;
     const Vec3 xo = world.center_of_mass(b);
-    const Mat3 ra = rg * rotation_local_;
+    const Mat3 ra = rg * m_.rotation_local;
     const Mat3 ro = world.orientation(b).toRotationMatrix();
     const Vec3 dtheta = math::so3::log(Mat3(ro * ra.transpose()));  // lab axis
-    const Vec3 elastic = -k_ * (xo - xa);
-    const Vec3 elastic_torque = -k_r_ * dtheta;
-    elastic_force_ = elastic.norm();
-    if (elastic_force_ > params_.max_hold_force || elastic_torque.norm() > params_.max_hold_torque) {
-      slipped_ = true;
+    const Vec3 elastic = -m_.k * (xo - xa);
+    const Vec3 elastic_torque = -m_.k_r * dtheta;
+    m_.elastic_force = elastic.norm();
+    if (m_.elastic_force > params_.max_hold_force || elastic_torque.norm() > params_.max_hold_torque) {
+      m_.slipped = true;
       release();
       return;
     }
     const Vec3 va = world.velocity_at_point(body_, xa);
-    weld_force_ = elastic - c_ * (world.linear_velocity(b) - va);
-    weld_torque_ = elastic_torque - c_r_ * (world.angular_velocity(b) - world.angular_velocity(body_));
-    world.add_force_and_torque(b, weld_force_, weld_torque_);
-    world.add_force_at_point(body_, -weld_force_, xo);
-    world.add_torque(body_, -weld_torque_);
+    m_.weld_force = elastic - m_.c * (world.linear_velocity(b) - va);
+    m_.weld_torque = elastic_torque - m_.c_r * (world.angular_velocity(b) - world.angular_velocity(body_));
+    world.add_force_and_torque(b, m_.weld_force, m_.weld_torque);
+    world.add_force_at_point(body_, -m_.weld_force, xo);
+    world.add_torque(body_, -m_.weld_torque);
   }
 
   ParallelGripperParameters params_;
@@ -280,15 +297,7 @@ class ParallelGripper {
   contact::ContactSet set_;
   contact::NarrowPhaseScratch scratch_;
   rigid::BodyId body_ = 0;
-  int command_ = 0, state_ = 0;
-  std::optional<rigid::BodyId> held_, last_released_;
-  double held_width_ = 0;
-  Vec3 anchor_local_ = Vec3::Zero();
-  Mat3 rotation_local_ = Mat3::Identity();
-  double k_ = 0, k_r_ = 0, c_ = 0, c_r_ = 0;
-  Vec3 weld_force_ = Vec3::Zero(), weld_torque_ = Vec3::Zero();
-  double elastic_force_ = 0;
-  bool grasped_now_ = false, released_now_ = false, slipped_ = false;
+  Snapshot m_;  ///< everything a step changes (copied whole by a world's rollback)
 };
 
 }  // namespace manisoft::interaction

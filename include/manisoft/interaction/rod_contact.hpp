@@ -1,4 +1,4 @@
-// Rod-contact policies of SoftArmWorld (issue 3, "rod against the world"): every rod element is a
+// Rod-contact policies of SoftArmWorld (the arm touching the table, obstacles and objects): every rod element is a
 // capsule (nodes k, k + 1, the rod's radius) that touches the rigid bodies of the world (table,
 // obstacles, objects) through a penalty force with damping and Coulomb friction with static
 // friction (a tangential stick-slip spring, Cundall & Strack 1979).
@@ -63,16 +63,22 @@
 
 #include <Eigen/Geometry>
 
+#include "manisoft/contact/mixing.hpp"
 #include "manisoft/contact/narrow_phase.hpp"
+#include "manisoft/contact/segment_capsule.hpp"
 #include "manisoft/core/error.hpp"
+#include "manisoft/interaction/stable_spring.hpp"
 #include "manisoft/rigid/rigid_world.hpp"
 
 namespace manisoft::interaction {
 
 /// No contact between rod elements and bodies (a free-space arm).
 struct NoRodContact {
+  struct Snapshot {};
   template <typename Rod>
   void apply(Rod&, rigid::RigidWorld&) {}
+  void save(Snapshot&, bool) const {}
+  void restore(const Snapshot&) {}
 };
 
 struct RodContactParameters {
@@ -137,6 +143,49 @@ class RodCapsuleContact {
     for (auto& a : anchors_) a.seen = 0;
   }
 
+  /// Stick-slip anchor of one contact point (see the header comment): the rod material point
+  /// (segment parameter, surface offset in the element's material frame) and the body point (body
+  /// frame, about the centre of mass) whose tangential separation is the spring's extension.
+  struct Anchor {
+    std::uint64_t seen = 0;  ///< apply() pass that last used it (live if the previous one)
+    std::uint32_t geom = 0;
+    int slot = 0;            ///< point index in the narrow phase's contact set
+    double segment_parameter = 0;
+    Vec3 rod_offset_material = Vec3::Zero();
+    Vec3 body_point = Vec3::Zero();
+  };
+
+  /// The friction anchors, for rollback. A full snapshot copies them; a step snapshot
+  /// (`full` = false, what SoftArmWorld takes before every step) records only the pass counter and
+  /// relies on the undo record apply() keeps of the anchors it changes, so it costs nothing.
+  struct Snapshot {
+    std::uint64_t pass = 1;
+    bool full = false;
+    std::vector<Anchor> anchors;
+  };
+  void save(Snapshot& out, bool full) const {
+    out.pass = pass_;
+    out.full = full;
+    if (full) out.anchors = anchors_;
+  }
+  /// Puts the anchors back to `in`: a full snapshot from any time, a step snapshot only across
+  /// the one apply() since it was taken.
+  void restore(const Snapshot& in) {
+    if (in.full) {
+      anchors_ = in.anchors;
+    } else if (in.pass + 1 == pass_) {
+      for (auto it = undo_.rbegin(); it != undo_.rend(); ++it) *it->anchor = it->before;
+      std::swap(contacts_, previous_contacts_);
+      narrow_calls_ = previous_narrow_calls_;
+      max_penetration_ = previous_max_penetration_;
+    } else if (in.pass != pass_) {
+      manisoft::detail::fail("RodCapsuleContact::restore: a step snapshot undoes one apply(), ", pass_ - in.pass, " ran since");
+    }
+    if (in.full) contacts_.clear();  // a report of another time is not restored
+    undo_.clear();
+    pass_ = in.pass;
+  }
+
   /// Contact points of the last apply() that carried a force.
   const std::vector<RodContactPoint>& contacts() const { return contacts_; }
   /// Narrow-phase calls in the last apply() (broad-phase efficiency).
@@ -158,12 +207,20 @@ class RodCapsuleContact {
     const double dt = double(rod.dt());
     const double radius = rod_radius(model);
     const double pad = radius + params_.margin;
+    // The last apply()'s report is kept for a step rollback (restore() swaps it back).
+    std::swap(contacts_, previous_contacts_);
     contacts_.clear();
+    previous_narrow_calls_ = narrow_calls_;
+    previous_max_penetration_ = max_penetration_;
     narrow_calls_ = 0;
     max_penetration_ = 0;
     // Anchors seen in the previous apply() (seen == pass_ - 1) are live; older ones are free.
     ++pass_;
-    if (anchors_.size() != std::size_t(n) * kAnchorSlots) anchors_.assign(std::size_t(n) * kAnchorSlots, Anchor{});
+    if (anchors_.size() != std::size_t(n) * kAnchorSlots) {
+      anchors_.assign(std::size_t(n) * kAnchorSlots, Anchor{});
+      undo_.reserve(anchors_.size());
+    }
+    undo_.clear();
 
     element_lo_.resize(std::size_t(n));
     element_hi_.resize(std::size_t(n));
@@ -198,17 +255,6 @@ class RodCapsuleContact {
   }
 
  private:
-  /// Stick-slip anchor of one contact point (see the header comment): the rod material point
-  /// (segment parameter, surface offset in the element's material frame) and the body point (body
-  /// frame, about the centre of mass) whose tangential separation is the spring's extension.
-  struct Anchor {
-    std::uint64_t seen = 0;  ///< apply() pass that last used it (live if the previous one)
-    std::uint32_t geom = 0;
-    int slot = 0;            ///< point index in the narrow phase's contact set
-    double segment_parameter = 0;
-    Vec3 rod_offset_material = Vec3::Zero();
-    Vec3 body_point = Vec3::Zero();
-  };
 
   /// The live anchor of (element k, geometry g, point slot i), else a free slot for it (marked
   /// new by seen != pass_ - 1), else nullptr (all slots held by live anchors).
@@ -235,138 +281,129 @@ class RodCapsuleContact {
     return std::sqrt(double(model.cross_section_area[0]) / 3.14159265358979323846);
   }
 
+  /// Effective mass of the rod-body pair at a contact point (see the header comment).
+  template <typename Model>
+  static double effective_mass(const Model& model, int k, double t, double radius, const rigid::RigidBodyModel& bm,
+                               const rigid::RigidBodyState& bs, const Vec3& point) {
+    double inv_m = (1 - t) * (1 - t) * double(model.inv_node_masses[k]) + t * t * double(model.inv_node_masses[k + 1]) +
+                   radius * radius / double(model.inertia(k, 2));
+    if (!bm.is_static) inv_m += bm.inverse_mass + (point - bs.position).squaredNorm() * bm.inverse_inertia.norm();
+    return 1.0 / inv_m;
+  }
+
+  /// Tangential separation d_t of a live anchor's two material points (zero for a new point).
+  template <typename State>
+  Vec3 anchor_separation(const Anchor* anchor, const State& state, int k, const Eigen::Matrix3d& q, const rigid::RigidBodyState& bs,
+                         const Vec3& n) const {
+    if (anchor == nullptr || anchor->seen + 1 != pass_) return Vec3::Zero();
+    const double ta = anchor->segment_parameter;
+    const Vec3 x_r = (1 - ta) * state.position(k) + ta * state.position(k + 1) + q.transpose() * anchor->rod_offset_material;
+    const Vec3 x_a = bs.position + bs.rotation * anchor->body_point;
+    const Vec3 d = x_r - x_a;
+    return d - d.dot(n) * n;
+  }
+
+  /// Stage 1: the capsule of element k (local x from its d1) against geometry g.
   template <typename Rod>
   void collide_element(Rod& rod, rigid::RigidWorld& world, int k, rigid::BodyId body, std::uint32_t g, const contact::Pose& gp,
                        double radius, double dt) {
+    const auto& state = rod.state();
+    const Eigen::Matrix3d q = state.director(k);  // rows d1, d2, d3
+    capsule_.set(state.position(k), state.position(k + 1), radius, q.row(0).transpose());
+    ++narrow_calls_;
+    if (!contact::collide(capsule_.shape(), capsule_.pose(), world.geoms()[g].shape, gp, 0.0, set_, scratch_)) return;
+    const double mu = contact::mix_friction(params_.friction, world.model(body).friction);
+    for (int i = 0; i < set_.count; ++i) {
+      if (set_.points[std::size_t(i)].separation < 0) contact_point(rod, world, k, body, g, i, q, radius, mu, dt);
+    }
+  }
+
+  /// Stage 2: the contact law at point i of the set (normal spring-damper, stick-slip friction),
+  /// stage 3: the forces on the two nodes, the element and the body, and the report.
+  template <typename Rod>
+  void contact_point(Rod& rod, rigid::RigidWorld& world, int k, rigid::BodyId body, std::uint32_t g, int i, const Eigen::Matrix3d& q,
+                     double radius, double mu, double dt) {
     const auto& model = rod.model();
     auto& state = rod.state();
-    const Vec3 p0 = state.position(k), p1 = state.position(k + 1);
-    const Vec3 axis = p1 - p0;
-    const double len = axis.norm();
-    capsule_.kind = contact::ShapeKind::capsule;
-    capsule_.radius = radius;
-    capsule_.half_length = 0.5 * len;
-    contact::Pose pose;
-    pose.translation = 0.5 * (p0 + p1);
-    const Eigen::Matrix3d q = state.director(k);  // rows d1, d2, d3
-    {
-      // Orthonormal frame with column 2 along the segment (the capsule's local z).
-      const Vec3 z = len > 0 ? Vec3(axis / len) : Vec3(q.row(2).transpose());
-      Vec3 x = q.row(0).transpose() - z * z.dot(q.row(0).transpose());
-      if (x.squaredNorm() < 1e-12) x = contact::detail::any_perpendicular(z);
-      x.normalize();
-      pose.rotation.col(0) = x;
-      pose.rotation.col(1) = z.cross(x);
-      pose.rotation.col(2) = z;
-    }
-    const auto kind = world.geoms()[g].shape.kind;
-    if (kind == contact::ShapeKind::cylinder || kind == contact::ShapeKind::convex) {
-      if (!fcl_capsule_) fcl_capsule_ = std::make_shared<fcl::Capsuled>(radius, len);
-      fcl_capsule_->radius = radius;
-      fcl_capsule_->lz = len;
-      fcl_capsule_->computeLocalAABB();
-      capsule_.fcl_geometry = fcl_capsule_;
-    }
-    ++narrow_calls_;
-    if (!contact::collide(capsule_, pose, world.geoms()[g].shape, gp, 0.0, set_, scratch_)) return;
-    const Vec3 n_lab = set_.normal;  // from the capsule (a) into the body (b)
     const auto& bm = world.model(body);
     const auto& bs = world.state(body);
-    const double mu = std::sqrt(params_.friction * bm.friction);
-    const Eigen::Vector3d omega_lab = q.transpose() * state.angular_velocity(k);
-    const double inv_j3 = 1.0 / double(model.inertia(k, 2));
-    for (int i = 0; i < set_.count; ++i) {
-      const auto& cp = set_.points[std::size_t(i)];
-      if (!(cp.separation < 0)) continue;
-      const double t = len > 0 ? std::clamp((cp.position - p0).dot(axis) / (len * len), 0.0, 1.0) : 0.0;
-      const Vec3 axis_point = p0 + t * axis;
-      const Vec3 arm = cp.position - axis_point;  // from the rod axis to the contact point
-      const Vec3 v_rod = (1 - t) * state.velocity(k) + t * state.velocity(k + 1) + omega_lab.cross(arm);
-      const Vec3 v_rel = v_rod - world.velocity_at_point(body, cp.position);
-      // Effective mass of the pair at this point.
-      double inv_m = (1 - t) * (1 - t) * double(model.inv_node_masses[k]) + t * t * double(model.inv_node_masses[k + 1]) +
-                     radius * radius * inv_j3;
-      if (!bm.is_static) {
-        const Vec3 rb = cp.position - bs.position;
-        inv_m += bm.inverse_mass + rb.squaredNorm() * bm.inverse_inertia.norm();
-      }
-      const double m_eff = 1.0 / inv_m;
-      const double k_cap = m_eff * (params_.max_omega_dt / dt) * (params_.max_omega_dt / dt);
-      const double stiffness = std::min(params_.stiffness, k_cap);
-      const double damping = 2.0 * params_.damping_ratio * std::sqrt(stiffness * m_eff);
-      const double depth = -cp.separation;
-      const double vn = v_rel.dot(n_lab);  // > 0: approaching
-      const double fn = std::max(0.0, stiffness * depth + damping * vn);
-      max_penetration_ = std::max(max_penetration_, depth);
-      Vec3 f_rod = -fn * n_lab;
-      const Vec3 vt = v_rel - vn * n_lab;
-      // Stick-slip spring: the tangential separation d_t of the anchor's two points (rod material
-      // point x_r, body point x_a), zero for a new point.
-      Anchor* anchor = find_anchor(k, g, i);
-      Vec3 d_tan = Vec3::Zero();
-      if (anchor != nullptr && anchor->seen + 1 == pass_) {
-        const double ta = anchor->segment_parameter;
-        const Vec3 x_r = (1 - ta) * p0 + ta * p1 + q.transpose() * anchor->rod_offset_material;
-        const Vec3 x_a = bs.position + bs.rotation * anchor->body_point;
-        const Vec3 d = x_r - x_a;
-        d_tan = d - d.dot(n_lab) * n_lab;
-      }
-      const double k_t = std::min(params_.tangential_stiffness_ratio * params_.stiffness, k_cap);
-      const double c_t = 2.0 * params_.tangential_damping_ratio * std::sqrt(k_t * m_eff);
-      // f_t* = -(k_t d_t + c_t v_t); on the Coulomb cone if |f_t*| > mu f_n.
-      Vec3 ft = -(k_t * d_tan + c_t * vt);
-      if (anchor == nullptr) ft = -c_t * vt;
-      const double ft_norm = ft.norm();
-      const double ft_max = mu * fn;
-      const bool sticking = ft_norm <= ft_max;
-      if (!sticking) {
-        ft *= ft_max / ft_norm;                             // kinetic: |f_t| = mu f_n, along f_t*
-        d_tan = k_t > 0 ? Vec3(-ft / k_t) : Vec3::Zero();  // anchor slid: the spring on the cone
-      }
-      f_rod += ft;
-      if (anchor != nullptr) {
-        // Re-base onto the current contact point c = axis point + arm, keeping d_t.
-        anchor->seen = pass_;
-        anchor->geom = g;
-        anchor->slot = i;
-        anchor->segment_parameter = t;
-        anchor->rod_offset_material = q * arm;
-        anchor->body_point = bs.rotation.transpose() * (cp.position - d_tan - bs.position);
-      }
-      if (fn == 0) continue;
-      // Rod: nodes by the segment parameter, the moment of the force about the axis to the element.
-      state.external_forces.row(k) += ((1 - t) * f_rod).transpose();
-      state.external_forces.row(k + 1) += (t * f_rod).transpose();
-      state.external_torques.row(k) += (q * arm.cross(f_rod)).transpose();
-      // Body: the opposite force at the contact point.
-      world.add_force_at_point(body, -f_rod, cp.position);
-      RodContactPoint rc;
-      rc.element = k;
-      rc.body = body;
-      rc.geom = g;
-      rc.segment_parameter = t;
-      rc.position = cp.position;
-      rc.normal = n_lab;
-      rc.separation = cp.separation;
-      rc.normal_force = fn;
-      rc.force_on_rod = f_rod;
-      rc.sticking = sticking;
-      contacts_.push_back(rc);
+    const auto& cp = set_.points[std::size_t(i)];
+    const Vec3 n_lab = set_.normal;  // from the capsule (a) into the body (b)
+    const double t = capsule_.segment_parameter(cp.position);
+    const Vec3 arm = cp.position - (state.position(k) + t * (state.position(k + 1) - state.position(k)));  // rod axis -> point
+    const Vec3 omega_lab = q.transpose() * state.angular_velocity(k);
+    const Vec3 v_rod = (1 - t) * state.velocity(k) + t * state.velocity(k + 1) + omega_lab.cross(arm);
+    const Vec3 v_rel = v_rod - world.velocity_at_point(body, cp.position);
+    const double m_eff = effective_mass(model, k, t, radius, bm, bs, cp.position);
+    // Normal: f_n = max(0, k p + c v_n).
+    const double stiffness = stable_stiffness(params_.stiffness, m_eff, params_.max_omega_dt, dt);
+    const double damping = damping_for_ratio(params_.damping_ratio, stiffness, m_eff);
+    const double depth = -cp.separation;
+    const double vn = v_rel.dot(n_lab);  // > 0: approaching
+    const double fn = std::max(0.0, stiffness * depth + damping * vn);
+    max_penetration_ = std::max(max_penetration_, depth);
+    // Friction: f_t* = -(k_t d_t + c_t v_t), on the Coulomb cone if |f_t*| > mu f_n.
+    const Vec3 vt = v_rel - vn * n_lab;
+    Anchor* anchor = find_anchor(k, g, i);
+    Vec3 d_tan = anchor_separation(anchor, state, k, q, bs, n_lab);
+    const double k_t = stable_stiffness(params_.tangential_stiffness_ratio * params_.stiffness, m_eff, params_.max_omega_dt, dt);
+    const double c_t = damping_for_ratio(params_.tangential_damping_ratio, k_t, m_eff);
+    Vec3 ft = anchor == nullptr ? Vec3(-c_t * vt) : Vec3(-(k_t * d_tan + c_t * vt));
+    const double ft_norm = ft.norm();
+    const double ft_max = mu * fn;
+    const bool sticking = ft_norm <= ft_max;
+    if (!sticking) {
+      ft *= ft_max / ft_norm;                             // kinetic: |f_t| = mu f_n, along f_t*
+      d_tan = k_t > 0 ? Vec3(-ft / k_t) : Vec3::Zero();  // anchor slid: the spring on the cone
     }
+    const Vec3 f_rod = -fn * n_lab + ft;
+    if (anchor != nullptr) {
+      // Re-base onto the current contact point c = axis point + arm, keeping d_t.
+      if (undo_.size() < undo_.capacity()) undo_.push_back({anchor, *anchor});
+      anchor->seen = pass_;
+      anchor->geom = g;
+      anchor->slot = i;
+      anchor->segment_parameter = t;
+      anchor->rod_offset_material = q * arm;
+      anchor->body_point = bs.rotation.transpose() * (cp.position - d_tan - bs.position);
+    }
+    if (fn == 0) return;
+    // Rod: nodes by the segment parameter, the moment of the force about the axis to the element.
+    state.external_forces.row(k) += ((1 - t) * f_rod).transpose();
+    state.external_forces.row(k + 1) += (t * f_rod).transpose();
+    state.external_torques.row(k) += (q * arm.cross(f_rod)).transpose();
+    // Body: the opposite force at the contact point.
+    world.add_force_at_point(body, -f_rod, cp.position);
+    RodContactPoint rc;
+    rc.element = k;
+    rc.body = body;
+    rc.geom = g;
+    rc.segment_parameter = t;
+    rc.position = cp.position;
+    rc.normal = n_lab;
+    rc.separation = cp.separation;
+    rc.normal_force = fn;
+    rc.force_on_rod = f_rod;
+    rc.sticking = sticking;
+    contacts_.push_back(rc);
   }
 
   RodContactParameters params_;
   std::vector<rigid::BodyId> excluded_;
   std::vector<Vec3> element_lo_, element_hi_;
-  std::vector<RodContactPoint> contacts_;
-  contact::CollisionShape capsule_;
-  std::shared_ptr<fcl::Capsuled> fcl_capsule_;
+  std::vector<RodContactPoint> contacts_, previous_contacts_;
+  contact::SegmentCapsule capsule_;
   contact::ContactSet set_;
   contact::NarrowPhaseScratch scratch_;
   std::vector<Anchor> anchors_;  ///< kAnchorSlots per element
+  struct AnchorUndo {
+    Anchor* anchor;
+    Anchor before;
+  };
+  std::vector<AnchorUndo> undo_;  ///< anchors changed by the last apply(), for restore()
   std::uint64_t pass_ = 1;       ///< apply() count (+1), for the anchors' liveness
-  int narrow_calls_ = 0;
-  double max_penetration_ = 0;
+  int narrow_calls_ = 0, previous_narrow_calls_ = 0;
+  double max_penetration_ = 0, previous_max_penetration_ = 0;
 };
 
 }  // namespace manisoft::interaction

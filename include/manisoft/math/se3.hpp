@@ -15,6 +15,8 @@
 // Everything uses fixed-size Eigen types: no heap allocation.
 #pragma once
 
+#include "manisoft/core/error.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross()
 
@@ -79,6 +81,17 @@ struct Pose {
   /// True when no coefficient is NaN or infinite.
   bool is_finite() const { return rotation.allFinite() && translation.allFinite(); }
 };
+
+/// Refuses (manisoft::InvalidInput, naming `who`) a pose that is not finite or whose rotation is
+/// not a rotation matrix (|R R^T - I| > 1e-6 or det R < 0): the one check every target goes through.
+template <typename Scalar>
+void require_valid_pose(const Pose<Scalar>& pose, const char* who) {
+  if (!pose.is_finite())
+    manisoft::detail::fail(who, ": pose refused, it is not finite (translation = ", pose.translation.transpose(), ")");
+  const Scalar e = (pose.rotation * pose.rotation.transpose() - Matrix3<Scalar>::Identity()).norm();
+  if (e > Scalar(1e-6) || pose.rotation.determinant() < 0)
+    manisoft::detail::fail(who, ": pose refused, its rotation is not a rotation matrix (|R R^T - I| = ", e, ")");
+}
 
 namespace detail {
 

@@ -48,10 +48,7 @@ namespace detail {
 /// A non-finite target is a caller bug, not a diverged simulation: refuse it.
 template <typename Scalar>
 void require_finite_target(const RewardInput<Scalar>& input) {
-  if (!input.target.is_finite()) {
-    manisoft::detail::fail("reward input: the target pose is not finite (translation = ",
-                           input.target.translation.transpose(), ")");
-  }
+  math::require_valid_pose(input.target, "reward input target");
 }
 
 }  // namespace detail

@@ -9,19 +9,23 @@
 // x += h v, q += h/2 w q -> relax -> restitution -> store.
 // Determinism: everything is iterated in body/geometry index order; broad-phase pairs are sorted.
 // Allocation: after the first steps (buffers grown to their working size) step() allocates only on
-// the FCL fallback path (sphere/capsule vs cylinder/mesh: FCL result vectors) and when the set of
-// overlapping pairs grows beyond its previous maximum (measured: no allocation in 10,000 steps of
-// each anchor scene S1-S6 after 2,000 warm-up steps; query_capsule allocates only on first use).
+// the FCL fallback path (FCL result vectors) and when the set of overlapping pairs grows beyond its
+// previous maximum; query_capsule allocates only on first use (BENCHMARKS.md has the counts).
+// Rollback: step() snapshots everything it changes (Snapshot) and restores it when a body's state
+// turns non-finite; assemblies that snapshot several parts at once call advance() instead.
 #pragma once
 
 #include "manisoft/contact/contact_solver.hpp"
+#include "manisoft/contact/mixing.hpp"
 #include "manisoft/contact/narrow_phase.hpp"
+#include "manisoft/contact/segment_capsule.hpp"
 #include "manisoft/rigid/rigid_body.hpp"
 
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 
 #include <algorithm>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace manisoft::rigid {
@@ -93,6 +97,10 @@ class RigidWorld {
     manager_ = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
   }
 
+  // Movable (builders return worlds by value; the FCL objects live on the heap, so the broad
+  // phase's pointers stay valid), not copyable (the FCL objects are owned once).
+  RigidWorld(RigidWorld&&) noexcept = default;
+  RigidWorld& operator=(RigidWorld&&) noexcept = default;
   RigidWorld(const RigidWorld&) = delete;
   RigidWorld& operator=(const RigidWorld&) = delete;
 
@@ -151,7 +159,9 @@ class RigidWorld {
     // Per-body step buffers at their working size now, so no step allocates for them; candidate
     // pairs get room for every pair of geoms (at most 16 per geom).
     const std::size_t bodies = models_.size(), g = geoms_.size();
-    previous_states_.reserve(bodies);
+    backup_.states.reserve(bodies);
+    backup_.fat_lo.reserve(g);
+    backup_.fat_hi.reserve(g);
     solver_bodies_.reserve(bodies);
     parent_.reserve(bodies);
     island_min_time_.reserve(bodies);
@@ -161,11 +171,25 @@ class RigidWorld {
 
   // ---- stepping -------------------------------------------------------------------------------
 
-  /// Advances the world by `dt` seconds. Throws manisoft::Error (world left at its previous
-  /// state) if a body's state becomes non-finite.
+  /// Advances the world by `dt` seconds. Throws manisoft::Diverged, with the world put back to
+  /// its state before the step (bodies, contact caches, counters), if a body's state becomes
+  /// non-finite; the loads queued for the failed step are dropped.
   void step(double dt) {
+    save(backup_);
+    try {
+      advance(dt);
+    } catch (...) {
+      restore(backup_);
+      clear_external_loads();
+      throw;
+    }
+  }
+
+  /// One step without the world's own snapshot, for assemblies that snapshot every part once per
+  /// step (world::SoftArmWorld): on an exception the world is partly advanced and the caller
+  /// restores it from its snapshot (save() / restore()).
+  void advance(double dt) {
     if (!std::isfinite(dt) || !(dt > 0)) ::manisoft::detail::fail("RigidWorld::step: dt = ", dt, " must be finite and > 0");
-    previous_states_ = states_;
     contact::ContactSolverSettings cs;
     cs.h = dt;
     const double hertz = settings_.contact_hertz > 0 ? std::min(settings_.contact_hertz, 0.25 / dt) : 0.125 / dt;
@@ -207,6 +231,50 @@ class RigidWorld {
     contact::apply_restitution(manifolds_, solver_bodies_, cs);
     contact::store_impulses(manifolds_, cs);
     finish_step(dt);
+  }
+
+  // ---- snapshot -------------------------------------------------------------------------------
+
+  /// Everything a step changes: body states, contact manifolds (cached points, warm-start
+  /// impulses, friction anchors), broad-phase boxes, counters. Reused between steps: saving into
+  /// the same snapshot allocates only when the number of manifolds grew.
+  struct Snapshot {
+    std::vector<RigidBodyState> states;
+    std::vector<contact::ContactManifold> manifolds;
+    std::vector<Vec3> fat_lo, fat_hi;
+    bool broadphase_dirty{true};
+    double time{0};
+    std::uint64_t step_count{0};
+  };
+  void save(Snapshot& out) const {
+    out.states = states_;
+    out.manifolds = manifolds_;
+    out.fat_lo.resize(geoms_.size());
+    out.fat_hi.resize(geoms_.size());
+    for (std::size_t g = 0; g < geoms_.size(); ++g) {
+      out.fat_lo[g] = geoms_[g].fat_lo;
+      out.fat_hi[g] = geoms_[g].fat_hi;
+    }
+    out.broadphase_dirty = broadphase_dirty_;
+    out.time = time_;
+    out.step_count = step_count_;
+  }
+  /// Puts the world back to a snapshot taken of it (same bodies).
+  void restore(const Snapshot& in) {
+    if (in.states.size() != states_.size() || in.fat_lo.size() != geoms_.size())
+      ::manisoft::detail::fail("RigidWorld::restore: the snapshot has ", in.states.size(), " bodies, the world ", states_.size());
+    states_ = in.states;
+    manifolds_ = in.manifolds;
+    for (std::uint32_t g = 0; g < geoms_.size(); ++g) {
+      if (geoms_[g].fat_lo == in.fat_lo[g] && geoms_[g].fat_hi == in.fat_hi[g]) continue;
+      geoms_[g].fat_lo = in.fat_lo[g];
+      geoms_[g].fat_hi = in.fat_hi[g];
+      fcl_objects_[g]->set_aabb(geoms_[g].fat_lo, geoms_[g].fat_hi);
+      manager_->update(fcl_objects_[g].get());
+    }
+    broadphase_dirty_ = in.broadphase_dirty;
+    time_ = in.time;
+    step_count_ = in.step_count;
   }
 
   // ---- queries --------------------------------------------------------------------------------
@@ -263,35 +331,20 @@ class RigidWorld {
       ::manisoft::detail::fail("RigidWorld::query_capsule: end points, radius = ", radius, " and margin = ", margin,
                                " must be finite (radius, margin >= 0)");
     }
-    contact::CollisionShape capsule;
-    capsule.kind = contact::ShapeKind::capsule;
-    capsule.radius = radius;
-    const Vec3 axis = p1 - p0;
-    const double len = axis.norm();
-    capsule.half_length = 0.5 * len;
-    contact::Pose pose;
-    pose.translation = 0.5 * (p0 + p1);
-    if (len > 0) {
-      pose.rotation = Quat::FromTwoVectors(Vec3::UnitZ(), axis / len).toRotationMatrix();
-    }
-    if (!query_geometry_) {
-      query_geometry_ = std::make_shared<fcl::Capsuled>(radius, len);
-      query_object_ = std::make_unique<detail::FatCollisionObject>(query_geometry_);
+    query_capsule_.set(p0, p1, radius, contact::detail::any_perpendicular(p1 - p0));
+    if (!query_object_) {
+      query_object_ = std::make_unique<detail::FatCollisionObject>(query_capsule_.fcl_capsule());
       query_object_->setUserData(nullptr);  // FCL leaves user data uninitialised
     }
-    query_geometry_->radius = radius;  // reused: no allocation per query
-    query_geometry_->lz = len;
-    query_geometry_->computeLocalAABB();
     const Vec3 pad = Vec3::Constant(radius + margin);
     query_object_->set_aabb(p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad);
-    capsule.fcl_geometry = query_geometry_;
     query_candidates_.clear();
     manager_->collide(query_object_.get(), &query_candidates_, &collect_query);
     std::sort(query_candidates_.begin(), query_candidates_.end());
     for (const auto g : query_candidates_) {
       const auto& geom = geoms_[g];
       const contact::Pose gp = geom_pose(g);
-      if (!contact::collide(capsule, pose, geom.shape, gp, margin, contact_scratch_, scratch_)) continue;
+      if (!contact::collide(query_capsule_.shape(), query_capsule_.pose(), geom.shape, gp, margin, contact_scratch_, scratch_)) continue;
       for (int k = 0; k < contact_scratch_.count; ++k) {
         const auto& cp = contact_scratch_.points[static_cast<std::size_t>(k)];
         CapsuleContact c;
@@ -300,7 +353,7 @@ class RigidWorld {
         c.position = cp.position;
         c.normal = contact_scratch_.normal;
         c.separation = cp.separation;
-        c.segment_parameter = len > 0 ? std::clamp((cp.position - p0).dot(axis) / (len * len), 0.0, 1.0) : 0.0;
+        c.segment_parameter = query_capsule_.segment_parameter(cp.position);
         out.push_back(c);
       }
     }
@@ -445,8 +498,8 @@ class RigidWorld {
       m.geom_b = gb;
       m.body_a = ba;
       m.body_b = bb;
-      m.friction = std::sqrt(models_[ba].friction * models_[bb].friction);
-      m.restitution = std::max(models_[ba].restitution, models_[bb].restitution);
+      m.friction = contact::mix_friction(models_[ba].friction, models_[bb].friction);
+      m.restitution = contact::mix_restitution(models_[ba].restitution, models_[bb].restitution);
       m.fresh = true;
       next_manifolds_.push_back(m);
     }
@@ -605,12 +658,11 @@ class RigidWorld {
       s.linear_velocity = b.v;
       s.angular_velocity = b.w;
       if (!s.position.allFinite() || !s.orientation.coeffs().allFinite() || !b.v.allFinite() || !b.w.allFinite()) {
-        const auto bad = s;
-        states_ = previous_states_;
-        ::manisoft::detail::fail("rigid body ", i, describe(static_cast<BodyId>(i)), " has a non-finite state at step ",
-                                 step_count_ + 1, " (t = ", time_ + h, " s): position (", bad.position.transpose(),
-                                 "), velocity (", bad.linear_velocity.transpose(), "), angular velocity (",
-                                 bad.angular_velocity.transpose(), "); the world keeps its previous state");
+        ::manisoft::detail::diverged(static_cast<long>(step_count_), "body " + std::to_string(i) + describe(static_cast<BodyId>(i)),
+                                     "rigid body ", i, describe(static_cast<BodyId>(i)), " has a non-finite state at step ",
+                                     step_count_ + 1, " (t = ", time_ + h, " s): position (", s.position.transpose(),
+                                     "), velocity (", b.v.transpose(), "), angular velocity (", b.w.transpose(),
+                                     "); the world keeps its previous state");
       }
       const double speed = s.linear_velocity.norm(), spin = s.angular_velocity.norm();
       s.travel += h * (speed + spin * models_[i].bounding_radius);
@@ -626,7 +678,8 @@ class RigidWorld {
 
   RigidWorldSettings settings_;
   std::vector<RigidBodyModel> models_;
-  std::vector<RigidBodyState> states_, previous_states_;
+  std::vector<RigidBodyState> states_;
+  Snapshot backup_;  ///< step()'s own rollback
   std::vector<RigidGeom> geoms_;
   std::vector<std::unique_ptr<detail::FatCollisionObject>> fcl_objects_;
   std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> manager_;
@@ -638,7 +691,7 @@ class RigidWorld {
   std::vector<double> island_min_time_;
   contact::ContactSet contact_scratch_;
   contact::NarrowPhaseScratch scratch_;
-  std::shared_ptr<fcl::Capsuled> query_geometry_;
+  contact::SegmentCapsule query_capsule_;
   std::unique_ptr<detail::FatCollisionObject> query_object_;
   std::vector<std::uint32_t> query_candidates_;
   double time_{0};

@@ -16,6 +16,7 @@
 // manisoft::Error naming the step and the element, and the state before that step is kept.
 #pragma once
 
+#include <string>
 #include <tuple>
 #include <type_traits>
 
@@ -78,27 +79,42 @@ class CosseratRod {
     damping_.setup(model_, dt_);
     std::apply([&](auto&... f) { (f.setup(model_), ...); }, forcings_);
     boundary_.setup(state_);
-    backup_ = state_;
+    backup_ = state_;  // sized once: step() copies into it without allocating
     compute_internal_forces_and_torques(model_, state_, workspace_);
   }
 
   // ---- stepping
-  /// Advances the rod by dt. Throws manisoft::Error (state unchanged) on non-finite loads or state.
+  /// Advances the rod by dt. Throws manisoft::Error (state unchanged) on non-finite loads or state:
+  /// InvalidInput for a non-finite load, Diverged for a non-finite or diverging state.
   void step() {
     backup_ = state_;
     try {
-      Integrator::step(*this, dt_);
-      check_state();
+      advance();
     } catch (...) {
       state_ = backup_;
       throw;
     }
+  }
+  void step(int count) {
+    for (int i = 0; i < count; ++i) step();
+  }
+  /// One dt without the rod's own backup, for assemblies that snapshot every part of a world once
+  /// per step (world::SoftArmWorld): on an exception the state is partly advanced and the caller
+  /// restores it with restore(). The step counter advances only on success.
+  void advance() {
+    step_start_time_ = state_.time;
+    Integrator::step(*this, dt_);
+    check_state();
     ++step_count_;
     state_.external_forces.setZero();
     state_.external_torques.setZero();
   }
-  void step(int count) {
-    for (int i = 0; i < count; ++i) step();
+  /// Puts back a state and step counter saved before a failed advance() (no allocation: the
+  /// state's arrays keep their size).
+  void restore(const State& state, long step_count) {
+    check_state_shape(state);
+    state_ = state;
+    step_count_ = step_count;
   }
 
   // ---- stages used by the integrator policies
@@ -192,17 +208,17 @@ class CosseratRod {
     const int n = model_.n_elements;
     for (int k = 0; k <= n; ++k)
       if (!state_.positions.row(k).allFinite() || !state_.velocities.row(k).allFinite())
-        manisoft::detail::fail("step ", step_count_, " (t = ", backup_.time, " s) produced a non-finite state at node ", k,
+        manisoft::detail::diverged(step_count_, "node " + std::to_string(k), "step ", step_count_, " (t = ", step_start_time_, " s) produced a non-finite state at node ", k,
                      " (position ", state_.positions.row(k), ", velocity ", state_.velocities.row(k),
                      "); the rod keeps its state before the step. Is dt below the stability limit and are the loads bounded?");
     for (int k = 0; k < n; ++k)
       if (!state_.angular_velocities.row(k).allFinite() || !state_.directors.row(k).allFinite())
-        manisoft::detail::fail("step ", step_count_, " (t = ", backup_.time, " s) produced a non-finite state at element ", k,
+        manisoft::detail::diverged(step_count_, "element " + std::to_string(k), "step ", step_count_, " (t = ", step_start_time_, " s) produced a non-finite state at element ", k,
                      " (angular velocity ", state_.angular_velocities.row(k), "); the rod keeps its state before the step");
     int worst = 0;
     for (int k = 0; k < n; ++k)
       if (std::abs(std::log(workspace_.dilatation[k])) > std::abs(std::log(workspace_.dilatation[worst]))) worst = k;
-    manisoft::detail::fail("step ", step_count_, " (t = ", backup_.time, " s): the rod diverged, element ", worst, " has dilatation ",
+    manisoft::detail::diverged(step_count_, "element " + std::to_string(worst), "step ", step_count_, " (t = ", step_start_time_, " s): the rod diverged, element ", worst, " has dilatation ",
                  workspace_.dilatation[worst], " (allowed 0.01 .. 100); the rod keeps its state before the step");
   }
 
@@ -212,6 +228,7 @@ class CosseratRod {
   Workspace workspace_;
   Scalar dt_;
   long step_count_ = 0;
+  Scalar step_start_time_ = 0;
   DampingPolicy damping_;
   BoundaryPolicy boundary_;
   std::tuple<Forcings<Scalar>...> forcings_;

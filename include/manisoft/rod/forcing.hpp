@@ -5,7 +5,7 @@
 //   UniformLabTorque     tau_k += Q_k (T u) / n: a total torque T u about a fixed lab axis
 //                        spread over the elements (PyElastica UniformTorques; u is not normalized).
 //   ElementTorques       tau_k += the user's N x 3 material-frame torques (the paper's action).
-//   BsplineMuscleTorques Elastica-RL muscle torques (MuscleTorquesWithVaryingBetaSplines):
+//   ElasticaRLMuscleTorques Elastica-RL muscle torques (MuscleTorquesWithVaryingBetaSplines):
 //                        T_k = scale * spline_dir(s_k) at s_k = sum_{j<=k} l_j (end of element
 //                        k, current lengths), applied as the difference
 //                          tau_k(dir) += T_k - T_{k+1}   (T_0 and T_n taken as 0),
@@ -108,15 +108,15 @@ class ElementTorques {
 /// T_k = scale * spline_d(s_k), although that cross-section sits at s_k - l_k: the couple lags
 /// the spline by one element, as in Elastica-RL (T_0 is never used).
 template <typename Scalar>
-class BsplineMuscleTorques {
+class ElasticaRLMuscleTorques {
  public:
   using Array = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
   int control_points = 6;       ///< per direction, excluding the two pinned ends
   Scalar scale = Scalar(75);    ///< Elastica-RL's alpha = beta = 75
 
   void setup(const RodModel<Scalar>& model) {
-    if (control_points < 2) manisoft::detail::fail("BsplineMuscleTorques control_points = ", control_points, " must be >= 2");
-    manisoft::detail::require_finite("BsplineMuscleTorques scale", scale);
+    if (control_points < 2) manisoft::detail::fail("ElasticaRLMuscleTorques control_points = ", control_points, " must be >= 2");
+    manisoft::detail::require_finite("ElasticaRLMuscleTorques scale", scale);
     const Scalar length = model.total_length();
     Array knots(control_points + 2);
     for (int i = 0; i < control_points + 2; ++i) knots[i] = length * Scalar(i) / Scalar(control_points + 1);
@@ -129,8 +129,8 @@ class BsplineMuscleTorques {
   template <typename Matrix>
   void set_control_points(const Matrix& activation) {
     if (activation.rows() != control_points || activation.cols() != 3)
-      manisoft::detail::fail("BsplineMuscleTorques expects ", control_points, " x 3 control points, got ", activation.rows(), " x ", activation.cols());
-    detail::require_finite_entries("BsplineMuscleTorques control point (index, direction)", activation);
+      manisoft::detail::fail("ElasticaRLMuscleTorques expects ", control_points, " x 3 control points, got ", activation.rows(), " x ", activation.cols());
+    detail::require_finite_entries("ElasticaRLMuscleTorques control point (index, direction)", activation);
     activation_ = activation;
     for (int d = 0; d < 3; ++d) {
       values_[0] = 0;

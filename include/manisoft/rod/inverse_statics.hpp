@@ -436,12 +436,7 @@ class InverseStatics {
   }
 
  private:
-  static void require_finite_target(const Pose& target) {
-    if (!target.is_finite()) manisoft::detail::fail("InverseStatics: the target pose is not finite (translation = ", target.translation.transpose(), ")");
-    const Matrix3 e = target.rotation * target.rotation.transpose() - Matrix3::Identity();
-    if (e.norm() > Scalar(1e-6) || target.rotation.determinant() < 0)
-      manisoft::detail::fail("InverseStatics: the target rotation is not a rotation matrix (|R R^T - I| = ", e.norm(), ")");
-  }
+  static void require_finite_target(const Pose& target) { math::require_valid_pose(target, "InverseStatics target"); }
 
   Scalar objective(const Residual& r, const Coefficients& c, Scalar mu) const {
     return r.squaredNorm() + mu * c.dot(regularizer_ * c);

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "manisoft/math/se3.hpp"
 #include "manisoft/rod/rod_model.hpp"
 
 namespace manisoft::rod {
@@ -44,6 +45,14 @@ struct RodState {
       for (int j = 0; j < 3; ++j) directors(element, 3 * i + j) = q(i, j);
   }
   Vector3 angular_velocity(int element) const { return angular_velocities.row(element).transpose(); }
+  /// The tip frame: origin at the last node, axes the last element's directors as columns
+  /// (rotation = Q_{n-1}^T maps tip coordinates to the lab).
+  math::Pose<Scalar> tip_pose() const {
+    math::Pose<Scalar> p;
+    p.rotation = director(n_elements() - 1).transpose();
+    p.translation = tip_position();
+    return p;
+  }
 };
 
 /// The straight rod at rest described by the parameters: nodes evenly spaced from the base along

@@ -62,15 +62,14 @@ inline std::vector<ObjectSpec> tabletop_objects(double top_z = 0.75, Eigen::Vect
   std::vector<ObjectSpec> out;
   auto add = [&](geometry::Shape<double> shape, Eigen::Vector3d position, double mass, const char* name, const char* kind,
                  Eigen::Quaterniond q = Eigen::Quaterniond::Identity()) {
-    ObjectSpec o;
-    o.desc.shape = std::move(shape);
-    o.desc.position = position;
-    o.desc.orientation = q;
-    o.desc.mass = mass;
-    o.desc.friction = 0.6;
-    o.desc.name = name;
-    o.kind = kind;
-    out.push_back(std::move(o));
+    rigid::RigidBodyDesc desc;
+    desc.shape.swap(shape);  // (a move assignment here trips GCC 12's -Wmaybe-uninitialized)
+    desc.position = position;
+    desc.orientation = q;
+    desc.mass = mass;
+    desc.friction = 0.6;
+    desc.name = name;
+    out.push_back(ObjectSpec{std::move(desc), kind});
   };
   const double z = top_z;
   add(geometry::Box<double>{Eigen::Vector3d::Constant(0.025)}, {target_xy.x(), target_xy.y(), z + 0.025}, 0.10, "cube", "box");
