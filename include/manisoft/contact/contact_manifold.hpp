@@ -70,6 +70,79 @@ struct ContactManifold {
 };
 
 /// Deterministic tangent basis of a unit normal.
+/// The part of a manifold that carries over from one step to the next (cached contact geometry,
+/// accumulated impulses, friction drift, re-detection bookkeeping). Every other field is
+/// recomputed by prepare_contacts before it is read, so this is all a rollback has to keep.
+struct ManifoldMemory {
+  std::uint32_t geom_a{0}, geom_b{0}, body_a{0}, body_b{0};
+  Vec3 normal_local{Vec3::UnitZ()};
+  NormalOwner owner{NormalOwner::shape_a};
+  bool fresh{true};
+  int count{0};
+  double friction{0.5}, restitution{0}, travel_a{0}, travel_b{0};
+  struct Point {
+    Vec3 anchor_a{Vec3::Zero()}, anchor_b{Vec3::Zero()};
+    double base_separation{0}, normal_impulse{0};
+  };
+  std::array<Point, kMaxContactPoints> points{};
+  Vec3 tangent_impulse{Vec3::Zero()}, drift{Vec3::Zero()};
+  double twist_impulse{0}, twist_drift{0};
+
+  static ManifoldMemory of(const ContactManifold& m) {
+    ManifoldMemory r;
+    r.geom_a = m.geom_a;
+    r.geom_b = m.geom_b;
+    r.body_a = m.body_a;
+    r.body_b = m.body_b;
+    r.normal_local = m.normal_local;
+    r.owner = m.owner;
+    r.fresh = m.fresh;
+    r.count = m.count;
+    r.friction = m.friction;
+    r.restitution = m.restitution;
+    r.travel_a = m.travel_a;
+    r.travel_b = m.travel_b;
+    for (int k = 0; k < m.count; ++k) {
+      const auto& p = m.points[static_cast<std::size_t>(k)];
+      r.points[static_cast<std::size_t>(k)] = {p.anchor_a, p.anchor_b, p.base_separation, p.normal_impulse};
+    }
+    r.tangent_impulse = m.patch.tangent_impulse;
+    r.drift = m.patch.drift;
+    r.twist_impulse = m.patch.twist_impulse;
+    r.twist_drift = m.patch.twist_drift;
+    return r;
+  }
+  /// A manifold with this memory (per-step fields default; prepare_contacts fills them).
+  ContactManifold manifold() const {
+    ContactManifold m;
+    m.geom_a = geom_a;
+    m.geom_b = geom_b;
+    m.body_a = body_a;
+    m.body_b = body_b;
+    m.normal_local = normal_local;
+    m.owner = owner;
+    m.fresh = fresh;
+    m.count = count;
+    m.friction = friction;
+    m.restitution = restitution;
+    m.travel_a = travel_a;
+    m.travel_b = travel_b;
+    for (int k = 0; k < count; ++k) {
+      const auto& p = points[static_cast<std::size_t>(k)];
+      auto& q = m.points[static_cast<std::size_t>(k)];
+      q.anchor_a = p.anchor_a;
+      q.anchor_b = p.anchor_b;
+      q.base_separation = p.base_separation;
+      q.normal_impulse = p.normal_impulse;
+    }
+    m.patch.tangent_impulse = tangent_impulse;
+    m.patch.drift = drift;
+    m.patch.twist_impulse = twist_impulse;
+    m.patch.twist_drift = twist_drift;
+    return m;
+  }
+};
+
 inline void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
   if (std::abs(n.x()) >= 0.57735) {
     t1 = Vec3(n.y(), -n.x(), 0.0).normalized();

@@ -159,13 +159,14 @@ class RigidWorld {
     // Per-body step buffers at their working size now, so no step allocates for them; candidate
     // pairs get room for every pair of geoms (at most 16 per geom).
     const std::size_t bodies = models_.size(), g = geoms_.size();
-    backup_.states.reserve(bodies);
-    backup_.fat_lo.reserve(g);
-    backup_.fat_hi.reserve(g);
+    record_.states.reserve(bodies);
+    record_.boxes.reserve(g);
     solver_bodies_.reserve(bodies);
     parent_.reserve(bodies);
     island_min_time_.reserve(bodies);
     pairs_.reserve(std::min(g * (g - 1) / 2, 16 * g));
+    record_.list.reserve(pairs_.capacity());
+    record_.manifolds.reserve(2 * pairs_.capacity());
     return id;
   }
 
@@ -175,19 +176,54 @@ class RigidWorld {
   /// its state before the step (bodies, contact caches, counters), if a body's state becomes
   /// non-finite; the loads queued for the failed step are dropped.
   void step(double dt) {
-    save(backup_);
+    begin_step();
     try {
       advance(dt);
     } catch (...) {
-      restore(backup_);
+      undo_step();
       clear_external_loads();
       throw;
     }
   }
 
-  /// One step without the world's own snapshot, for assemblies that snapshot every part once per
-  /// step (world::SoftArmWorld): on an exception the world is partly advanced and the caller
-  /// restores it from its snapshot (save() / restore()).
+  /// Starts recording what the next advance() changes (body states, the manifolds it touches,
+  /// the broad-phase boxes it moves, counters), so undo_step() can put the world back: the cheap
+  /// per-step rollback (what a step touches, not the whole world) that step() and the arm world use.
+  void begin_step() {
+    record_.states = states_;
+    record_.list_saved = false;
+    record_.manifolds.clear();
+    record_.boxes.clear();
+    record_.broadphase_dirty = broadphase_dirty_;
+    record_.time = time_;
+    record_.step_count = step_count_;
+    recording_ = true;
+  }
+  /// Undoes everything since begin_step().
+  void undo_step() {
+    if (!recording_) ::manisoft::detail::fail("RigidWorld::undo_step without begin_step");
+    states_ = record_.states;
+    if (record_.list_saved) {
+      manifolds_.resize(record_.list.size());
+      for (std::size_t i = 0; i < manifolds_.size(); ++i) manifolds_[i] = record_.list[i].manifold();
+    } else {
+      for (auto it = record_.manifolds.rbegin(); it != record_.manifolds.rend(); ++it) manifolds_[it->first] = it->second.manifold();
+    }
+    for (auto it = record_.boxes.rbegin(); it != record_.boxes.rend(); ++it) {
+      auto& geom = geoms_[it->geom];
+      geom.fat_lo = it->lo;
+      geom.fat_hi = it->hi;
+      fcl_objects_[it->geom]->set_aabb(geom.fat_lo, geom.fat_hi);
+      manager_->update(fcl_objects_[it->geom].get());
+    }
+    broadphase_dirty_ = record_.broadphase_dirty;
+    time_ = record_.time;
+    step_count_ = record_.step_count;
+    recording_ = false;
+  }
+
+  /// One step. Without begin_step() a failure leaves the world partly advanced; with it,
+  /// undo_step() restores it (step() does both).
   void advance(double dt) {
     if (!std::isfinite(dt) || !(dt > 0)) ::manisoft::detail::fail("RigidWorld::step: dt = ", dt, " must be finite and > 0");
     contact::ContactSolverSettings cs;
@@ -218,8 +254,10 @@ class RigidWorld {
         b.inv_inertia = s.rotation * m.inverse_inertia * s.rotation.transpose();
       }
     }
-    for (auto& m : manifolds_) {
+    for (std::size_t i = 0; i < manifolds_.size(); ++i) {
+      auto& m = manifolds_[i];
       m.active = m.count > 0 && (is_moving(m.body_a) || is_moving(m.body_b));
+      if (m.active) record_manifold(i);  // its impulses and friction drift change below
     }
     contact::prepare_contacts(manifolds_, states_, solver_bodies_);
     integrate_velocities(dt);
@@ -235,12 +273,12 @@ class RigidWorld {
 
   // ---- snapshot -------------------------------------------------------------------------------
 
-  /// Everything a step changes: body states, contact manifolds (cached points, warm-start
-  /// impulses, friction anchors), broad-phase boxes, counters. Reused between steps: saving into
-  /// the same snapshot allocates only when the number of manifolds grew.
+  /// Everything a step changes: body states, what the contact manifolds carry between steps
+  /// (cached points, warm-start impulses, friction drift), broad-phase boxes, counters. Reused
+  /// between steps: saving into the same snapshot allocates only when the number of manifolds grew.
   struct Snapshot {
     std::vector<RigidBodyState> states;
-    std::vector<contact::ContactManifold> manifolds;
+    std::vector<contact::ManifoldMemory> manifolds;
     std::vector<Vec3> fat_lo, fat_hi;
     bool broadphase_dirty{true};
     double time{0};
@@ -248,7 +286,8 @@ class RigidWorld {
   };
   void save(Snapshot& out) const {
     out.states = states_;
-    out.manifolds = manifolds_;
+    out.manifolds.resize(manifolds_.size());
+    for (std::size_t i = 0; i < manifolds_.size(); ++i) out.manifolds[i] = contact::ManifoldMemory::of(manifolds_[i]);
     out.fat_lo.resize(geoms_.size());
     out.fat_hi.resize(geoms_.size());
     for (std::size_t g = 0; g < geoms_.size(); ++g) {
@@ -264,7 +303,8 @@ class RigidWorld {
     if (in.states.size() != states_.size() || in.fat_lo.size() != geoms_.size())
       ::manisoft::detail::fail("RigidWorld::restore: the snapshot has ", in.states.size(), " bodies, the world ", states_.size());
     states_ = in.states;
-    manifolds_ = in.manifolds;
+    manifolds_.resize(in.manifolds.size());
+    for (std::size_t i = 0; i < manifolds_.size(); ++i) manifolds_[i] = in.manifolds[i].manifold();
     for (std::uint32_t g = 0; g < geoms_.size(); ++g) {
       if (geoms_[g].fat_lo == in.fat_lo[g] && geoms_[g].fat_hi == in.fat_hi[g]) continue;
       geoms_[g].fat_lo = in.fat_lo[g];
@@ -452,6 +492,11 @@ class RigidWorld {
   static bool is_round(contact::ShapeKind k) { return k == contact::ShapeKind::sphere || k == contact::ShapeKind::capsule; }
   bool is_moving(BodyId id) const { return !models_[id].is_static && states_[id].awake; }
 
+  /// Keeps manifold i's memory from before this step (once the list was saved whole, that covers it).
+  void record_manifold(std::size_t i) {
+    if (recording_ && !record_.list_saved) record_.manifolds.emplace_back(static_cast<std::uint32_t>(i), contact::ManifoldMemory::of(manifolds_[i]));
+  }
+
   /// Recomputes the fat AABB of geometry g if its margin-inflated bounds left it (or if forced).
   bool refresh_fat_bounds(std::uint32_t g, bool force) {
     auto& geom = geoms_[g];
@@ -462,6 +507,7 @@ class RigidWorld {
     hi += m;
     if (!force && (lo.array() >= geom.fat_lo.array()).all() && (hi.array() <= geom.fat_hi.array()).all()) return false;
     const Vec3 slack = Vec3::Constant(models_[geom.body].is_static ? 0.0 : 2.0 * settings_.contact_margin + 0.002);
+    if (recording_) record_.boxes.push_back({g, geom.fat_lo, geom.fat_hi});
     geom.fat_lo = lo - slack;
     geom.fat_hi = hi + slack;
     fcl_objects_[g]->set_aabb(geom.fat_lo, geom.fat_hi);
@@ -503,12 +549,18 @@ class RigidWorld {
       m.fresh = true;
       next_manifolds_.push_back(m);
     }
+    if (recording_ && !record_.list_saved) {
+      record_.list.resize(manifolds_.size());
+      for (std::size_t i = 0; i < manifolds_.size(); ++i) record_.list[i] = contact::ManifoldMemory::of(manifolds_[i]);
+      record_.list_saved = true;
+    }
     std::swap(manifolds_, next_manifolds_);
   }
 
   void update_narrowphase() {
     const double redetect = 0.5 * settings_.contact_margin;
-    for (auto& m : manifolds_) {
+    for (std::size_t i = 0; i < manifolds_.size(); ++i) {
+      auto& m = manifolds_[i];
       const auto& sa = states_[m.body_a];
       const auto& sb = states_[m.body_b];
       // Analytic pairs with a rounded shape are re-evaluated every step while a body moves: they
@@ -519,6 +571,7 @@ class RigidWorld {
                                   (is_round(kb) && ka == contact::ShapeKind::box);
       const bool moving = is_moving(m.body_a) || is_moving(m.body_b);
       if (!m.fresh && !(analytic_round && moving) && (sa.travel - m.travel_a) + (sb.travel - m.travel_b) <= redetect) continue;
+      record_manifold(i);
       m.fresh = false;
       m.travel_a = sa.travel;
       m.travel_b = sb.travel;
@@ -674,12 +727,28 @@ class RigidWorld {
     }
     time_ += h;
     ++step_count_;
+    recording_ = false;
   }
 
   RigidWorldSettings settings_;
   std::vector<RigidBodyModel> models_;
   std::vector<RigidBodyState> states_;
-  Snapshot backup_;  ///< step()'s own rollback
+  struct StepRecord {
+    std::vector<RigidBodyState> states;
+    bool list_saved{false};
+    std::vector<contact::ManifoldMemory> list;
+    std::vector<std::pair<std::uint32_t, contact::ManifoldMemory>> manifolds;
+    struct Box {
+      std::uint32_t geom;
+      Vec3 lo, hi;
+    };
+    std::vector<Box> boxes;
+    bool broadphase_dirty{true};
+    double time{0};
+    std::uint64_t step_count{0};
+  };
+  StepRecord record_;  ///< what the current step changed (begin_step / undo_step)
+  bool recording_{false};
   std::vector<RigidGeom> geoms_;
   std::vector<std::unique_ptr<detail::FatCollisionObject>> fcl_objects_;
   std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> manager_;

@@ -61,6 +61,7 @@ class SoftArmWorld {
     typename Device::Snapshot device;
     interaction::SpringWrench last_wrench;
     long step_count = 0;
+    bool full = true;  ///< false: a step snapshot (the rigid world and rod contact record the step)
   };
 
   SoftArmWorld(Rod rod, rigid::RigidWorldSettings settings, const interaction::EndEffectorDesc& end_effector, Coupling coupling = {},
@@ -86,6 +87,7 @@ class SoftArmWorld {
   // ---- stepping
   void step() {
     save(snapshot_, /*full=*/false);
+    rigid_.begin_step();
     try {
       advance();
     } catch (const Diverged& e) {
@@ -102,13 +104,15 @@ class SoftArmWorld {
     for (int i = 0; i < count; ++i) step();
   }
 
-  /// Saves everything a step changes (reuses `out`'s storage). A step snapshot (`full` = false,
-  /// taken by step() itself) leaves the rod contact's anchors to its undo record of one step; a
-  /// full one (the default) can be restored after any number of steps.
+  /// Saves everything a step changes (reuses `out`'s storage). A full snapshot (the default) can
+  /// be restored after any number of steps; a step snapshot (`full` = false, what step() takes)
+  /// leaves the rigid world and the rod contact to their own records of one step, which cost
+  /// only what that step touches.
   void save(Snapshot& out, bool full = true) const {
+    out.full = full;
     out.rod = rod_.state();
     out.rod_step_count = rod_.step_count();
-    rigid_.save(out.rigid);
+    if (full) rigid_.save(out.rigid);
     rod_contact_.save(out.rod_contact, full);
     device_.save(out.device);
     out.last_wrench = last_wrench_;
@@ -119,7 +123,11 @@ class SoftArmWorld {
     rod_.restore(in.rod, in.rod_step_count);
     rod_.state().external_forces.setZero();
     rod_.state().external_torques.setZero();
-    rigid_.restore(in.rigid);
+    if (in.full) {
+      rigid_.restore(in.rigid);
+    } else {
+      rigid_.undo_step();
+    }
     rigid_.clear_external_loads();
     rod_contact_.restore(in.rod_contact);
     device_.restore(in.device);
