@@ -62,6 +62,7 @@ struct ContactManifold {
   PatchFriction patch{};
   double travel_a{0}, travel_b{0};  ///< body travel when last detected
   bool fresh{true};                 ///< never run through the narrow phase
+  bool rolling{false};              ///< last detection was a rolling contact (ContactSet::rolling)
   // Per step.
   Vec3 normal{Vec3::UnitZ()}, tangent1{Vec3::UnitX()}, tangent2{Vec3::UnitY()};
   bool active{false};
