@@ -261,7 +261,7 @@ namespace {
 struct InclineRun {
   double acceleration{0};          ///< of the centre of mass along the slope, m/s^2 (fitted)
   double angular_acceleration{0};  ///< about the axis, rad/s^2 (fitted)
-  double lift{0};                  ///< largest rise of the centre above the contact plane
+  double bump{0};                  ///< spread (max - min) of the centre's height above the slope
 };
 
 /// A cylinder lying across an incline of `angle` (axis horizontal, rolling down along the slope),
@@ -290,10 +290,15 @@ InclineRun roll_down(double angle, double mu) {
   Eigen::MatrixXd A(0, 3);
   std::vector<double> ts, ss, ws;
   InclineRun out;
+  double lowest = INFINITY, highest = -INFINITY;
   for (int i = 1; i <= 2750; ++i) {
     w.step(kDt);
     const double t = i * kDt;
-    out.lift = std::max(out.lift, (w.center_of_mass(id) - start).dot(normal));
+    if (i >= 250) {  // after settling into the soft contact
+      const double height = (w.center_of_mass(id) - start).dot(normal);
+      lowest = std::min(lowest, height);
+      highest = std::max(highest, height);
+    }
     if (i >= 250 && i % 10 == 0) {
       ts.push_back(t);
       ss.push_back((w.center_of_mass(id) - start).dot(down_slope));
@@ -310,6 +315,7 @@ InclineRun roll_down(double angle, double mu) {
     s[k] = ss[static_cast<std::size_t>(k)];
     wv[k] = ws[static_cast<std::size_t>(k)];
   }
+  out.bump = highest - lowest;
   out.acceleration = M.colPivHouseholderQr().solve(s)[2];
   out.angular_acceleration = std::abs(L.colPivHouseholderQr().solve(wv)[1]);
   return out;
@@ -324,10 +330,10 @@ TEST_CASE("a cylinder lying on an incline rolls at 2/3 g sin t and slips at g (s
     const auto run = roll_down(t, 0.6);
     const double expected = 2.0 / 3.0 * g * std::sin(t);
     INFO("acceleration " << run.acceleration << " m/s^2 vs 2/3 g sin t = " << expected << "; alpha " << run.angular_acceleration
-                         << " vs a / r = " << expected / kR << "; largest lift " << run.lift << " m");
+                         << " vs a / r = " << expected / kR << "; height spread " << run.bump << " m");
     CHECK(run.acceleration == Approx(expected).epsilon(0.03));
     CHECK(run.angular_acceleration == Approx(expected / kR).epsilon(0.03));  // rolling: alpha = a / r
-    CHECK(run.lift < 1e-4);  // no facet bumps
+    CHECK(run.bump < 1e-5);  // no facet bumps (a 16-sided prism rises and falls by 0.15 mm)
   }
   SECTION("30 degrees, mu = 0.1 (tan t > 3 mu): slipping, friction at its Coulomb limit") {
     const double t = scenes::deg(30), mu = 0.1;
