@@ -397,3 +397,57 @@ TEST_CASE("rolling, standing and stacked curved bodies step without heap allocat
   CHECK(allocations == 0);
   CHECK(w.linear_velocity(roller).x() > 0.25);  // still rolling (no drag from facets)
 }
+
+TEST_CASE("a tilted cylinder dropped on the table settles on its cap without gaining energy", "[world][cylinder][energy]") {
+  rigid::RigidWorldSettings st;
+  st.enable_sleep = false;
+  rigid::RigidWorld w(st);
+  scenes::add_table(w);
+  // Tilted 20 degrees (less than atan(r / h) = 26.6: it falls back onto its cap), 1 cm up.
+  const double t = scenes::deg(20);
+  const auto id = scenes::add(w, geometry::Cylinder<double>{kR, kH}, {0, 0, kH * std::cos(t) + kR * std::sin(t) + 0.01}, 800,
+                              about_y(t));
+  const double start = w.mechanical_energy();
+  double lowest = start, worst_gain = 0, worst_time = 0;
+  for (int i = 0; i < 15000; ++i) {  // 3 s
+    w.step(kDt);
+    const double e = w.mechanical_energy();
+    if (e - lowest > worst_gain) {
+      worst_gain = e - lowest;
+      worst_time = w.time();
+    }
+    lowest = std::min(lowest, e);
+  }
+  // Bound: what the soft contact may store and give back, a spring of at most m g x 1 um.
+  const double spring = w.model(id).mass * 9.81 * 1e-6;
+  const double tilt = std::acos(std::clamp((w.orientation(id) * Vector3d::UnitZ()).z(), -1.0, 1.0));
+  INFO("largest rise above the running minimum " << worst_gain << " J at t = " << worst_time << " s (bound " << spring
+                                                 << " J); final height " << w.position(id).z()
+                                                 << ", tilt " << tilt << " rad, speed " << w.linear_velocity(id).norm());
+  CHECK(worst_gain <= spring);
+  CHECK(tilt < 1e-3);                 // back on its cap
+  CHECK(w.position(id).z() == Approx(kH).margin(0.5e-3));
+  CHECK(w.linear_velocity(id).norm() < 1e-3);
+}
+
+TEST_CASE("three cans lying in a pyramid stand (parallel side lines: two-point contacts)", "[world][cylinder][stack]") {
+  rigid::RigidWorldSettings st;
+  st.enable_sleep = false;
+  rigid::RigidWorld w(st);
+  scenes::add_table(w);
+  const Quat along_y = about_x(std::numbers::pi / 2);
+  const auto left = scenes::add(w, geometry::Cylinder<double>{kR, kH}, {-kR, 0, kR}, 800, along_y);
+  const auto right = scenes::add(w, geometry::Cylinder<double>{kR, kH}, {kR, 0, kR}, 800, along_y);
+  // On top, in the groove: centres 2r apart, so sqrt(3) r above the lower ones.
+  const auto top = scenes::add(w, geometry::Cylinder<double>{kR, kH}, {0, 0, kR + std::sqrt(3.0) * kR}, 800, along_y);
+  const Vector3d p0 = w.position(top);
+  for (int i = 0; i < 15000; ++i) w.step(kDt);  // 3 s
+  const double moved = (w.position(top) - p0).norm();
+  INFO("top moved " << moved << " m; lower cans at x = " << w.position(left).x() << ", " << w.position(right).x());
+  CHECK(moved < 0.5e-3);
+  CHECK(w.position(left).x() == Approx(-kR).margin(0.5e-3));
+  CHECK(w.position(right).x() == Approx(kR).margin(0.5e-3));
+  for (const auto& m : w.manifolds()) {
+    if (m.body_a != 0 && m.count > 0) CHECK(m.count == 2);  // can against can: the two ends of the line
+  }
+}
