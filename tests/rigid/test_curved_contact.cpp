@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 using namespace manisoft;
 using Eigen::Vector3d;
@@ -450,4 +451,64 @@ TEST_CASE("three cans lying in a pyramid stand (parallel side lines: two-point c
   for (const auto& m : w.manifolds()) {
     if (m.body_a != 0 && m.count > 0) CHECK(m.count == 2);  // can against can: the two ends of the line
   }
+}
+
+TEST_CASE("GJK/EPA answers are optimal over the support-function bounds (random poses)", "[world][contact][gjk]") {
+  // With M = A - B (cores), h(u) = max over M of u . x = u . (s_A(u) - s_B(-u)):
+  //  separated: the distance is max over unit u of -h(-u), reached at u = -n (n from A to B);
+  //  overlapping: the penetration depth is min over unit u of h(u), reached at u = n.
+  std::mt19937_64 rng(20261124);
+  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  auto unit = [&]() {
+    Vector3d u;
+    do u = Vector3d(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)); while (u.squaredNorm() > 1 || u.squaredNorm() < 1e-4);
+    return Vector3d(u.normalized());
+  };
+  auto rotation = [&]() {
+    Eigen::Vector4d q(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+    return Quat(q[0], q[1], q[2], q[3]).normalized();
+  };
+  geometry::ConvexMesh<double> mesh;  // an irregular octahedron
+  mesh.vertices = {{0.04, 0, 0}, {-0.03, 0, 0}, {0, 0.05, 0}, {0, -0.02, 0}, {0, 0, 0.035}, {0, 0, -0.045}};
+  mesh.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  mesh.source = "octahedron";
+  const std::array<contact::CollisionShape, 5> others = {
+      cylinder_shape(0.02, 0.04), contact::make_collision_shape(geometry::Sphere<double>{0.025}),
+      contact::make_collision_shape(geometry::Capsule<double>{0.015, 0.04}), box_shape(Vector3d(0.03, 0.02, 0.05)),
+      contact::make_collision_shape(geometry::PrimitiveShape<double>(mesh))};
+  const auto cyl = cylinder_shape();
+  int separated = 0, overlapping = 0;
+  double worst = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    const auto& other = others[static_cast<std::size_t>(trial % 5)];
+    const contact::ConvexSupport a{&cyl, pose(Vector3d::Zero(), rotation())};
+    const contact::ConvexSupport b{&other, pose(Vector3d(uniform(-0.09, 0.09), uniform(-0.09, 0.09), uniform(-0.09, 0.09)), rotation())};
+    contact::ConvexDistance d;
+    if (!contact::convex_distance(a, b, 1.0, d)) continue;
+    const double radii = a.core_radius() + b.core_radius();
+    auto h = [&](const Vector3d& u) { return u.dot(a.support(u) - b.support(-u)); };
+    const double core = d.separation + radii;  // signed distance of the cores
+    CAPTURE(trial, core, d.normal.transpose());
+    REQUIRE(std::abs(d.normal.norm() - 1) < 1e-12);
+    if (!d.penetrating) {
+      ++separated;
+      CHECK(-h(d.normal) == Approx(core).margin(1e-8));  // lower bound -h(-u) at u = -n
+      for (int k = 0; k < 200; ++k) {
+        const Vector3d u = unit();
+        worst = std::max(worst, -h(-u) - core);
+      }
+      CHECK((d.point_b - d.point_a).dot(d.normal) == Approx(d.separation).margin(1e-8));
+    } else {
+      ++overlapping;
+      CHECK(h(d.normal) == Approx(-core).margin(1e-8));  // reached at u = n
+      for (int k = 0; k < 200; ++k) {
+        const Vector3d u = unit();
+        worst = std::max(worst, -core - h(u));  // no direction with a smaller overlap
+      }
+    }
+  }
+  INFO(separated << " separated, " << overlapping << " overlapping; worst bound violation " << worst << " m");
+  CHECK(separated > 50);
+  CHECK(overlapping > 50);
+  CHECK(worst < 1e-8);
 }
