@@ -459,14 +459,20 @@ TEST_CASE("GJK/EPA answers are optimal over the support-function bounds (random 
   //  overlapping: the penetration depth is min over unit u of h(u), reached at u = n.
   std::mt19937_64 rng(20261124);
   auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  auto vector = [&](double half) {  // one draw per statement: argument order is unspecified
+    Vector3d u;
+    for (int k = 0; k < 3; ++k) u[k] = uniform(-half, half);
+    return u;
+  };
   auto unit = [&]() {
     Vector3d u;
-    do u = Vector3d(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)); while (u.squaredNorm() > 1 || u.squaredNorm() < 1e-4);
+    do u = vector(1.0); while (u.squaredNorm() > 1 || u.squaredNorm() < 1e-4);
     return Vector3d(u.normalized());
   };
   auto rotation = [&]() {
-    Eigen::Vector4d q(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
-    return Quat(q[0], q[1], q[2], q[3]).normalized();
+    const double w = uniform(-1, 1);
+    const Vector3d xyz = vector(1.0);
+    return Quat(w, xyz.x(), xyz.y(), xyz.z()).normalized();
   };
   geometry::ConvexMesh<double> mesh;  // an irregular octahedron
   mesh.vertices = {{0.04, 0, 0}, {-0.03, 0, 0}, {0, 0.05, 0}, {0, -0.02, 0}, {0, 0, 0.035}, {0, 0, -0.045}};
@@ -482,7 +488,8 @@ TEST_CASE("GJK/EPA answers are optimal over the support-function bounds (random 
   for (int trial = 0; trial < 500; ++trial) {
     const auto& other = others[static_cast<std::size_t>(trial % 5)];
     const contact::ConvexSupport a{&cyl, pose(Vector3d::Zero(), rotation())};
-    const contact::ConvexSupport b{&other, pose(Vector3d(uniform(-0.09, 0.09), uniform(-0.09, 0.09), uniform(-0.09, 0.09)), rotation())};
+    const Vector3d where = vector(0.09);
+    const contact::ConvexSupport b{&other, pose(where, rotation())};
     contact::ConvexDistance d;
     if (!contact::convex_distance(a, b, 1.0, d)) continue;
     const double radii = a.core_radius() + b.core_radius();
