@@ -519,3 +519,43 @@ TEST_CASE("GJK/EPA answers are optimal over the support-function bounds (random 
   CHECK(overlapping > 50);
   CHECK(worst < 1e-8);
 }
+
+TEST_CASE("the analytic shortcuts agree with GJK/EPA on shallow contacts (random poses)", "[world][contact][gjk]") {
+  // Random poses, then B moved along the GJK/EPA normal to a separation in [-1 mm, 2 mm]: the
+  // narrow phase (analytic cylinder-box face and side-side paths, or GJK/EPA + clipping) must find
+  // the same normal and deepest separation as GJK/EPA itself.
+  std::mt19937_64 rng(424242);
+  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  auto rotation = [&]() {
+    Eigen::Vector4d q;
+    for (int k = 0; k < 4; ++k) q[k] = uniform(-1, 1);
+    return Quat(q[0], q[1], q[2], q[3]).normalized();
+  };
+  const std::array<contact::CollisionShape, 4> others = {
+      cylinder_shape(0.02, 0.04), contact::make_collision_shape(geometry::Sphere<double>{0.025}),
+      contact::make_collision_shape(geometry::Capsule<double>{0.015, 0.04}), box_shape(Vector3d(0.03, 0.02, 0.05))};
+  const auto cyl = cylinder_shape();
+  contact::ContactSet c;
+  contact::NarrowPhaseScratch scratch;
+  int checked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const auto& other = others[static_cast<std::size_t>(trial % 4)];
+    const contact::Pose pa = pose(Vector3d::Zero(), rotation());
+    Vector3d where;
+    for (int k = 0; k < 3; ++k) where[k] = uniform(-0.1, 0.1);
+    contact::Pose pb = pose(where, rotation());
+    contact::ConvexDistance d;
+    if (!contact::convex_distance({&cyl, pa}, {&other, pb}, 1.0, d)) continue;
+    const double target = uniform(-1e-3, 2e-3);
+    pb.translation += (target - d.separation) * d.normal;
+    REQUIRE(contact::convex_distance({&cyl, pa}, {&other, pb}, 1.0, d));
+    CAPTURE(trial, target, d.separation, d.normal.transpose());
+    REQUIRE(contact::collide(cyl, pa, other, pb, 0.002, c, scratch));
+    double deepest = 1;
+    for (int k = 0; k < c.count; ++k) deepest = std::min(deepest, c.points[static_cast<std::size_t>(k)].separation);
+    CHECK(deepest == Approx(d.separation).margin(1e-6));
+    CHECK(c.normal.dot(d.normal) > 1 - 1e-6);
+    ++checked;
+  }
+  CHECK(checked > 300);
+}

@@ -1,7 +1,8 @@
 // Multi-point contacts of convex shapes on their true surfaces, for every pair with a cylinder and
 // for sphere/capsule against a convex mesh:
 //  1. the contact normal n (from A to B) and signed distance: analytic for a cylinder on a box face
-//     (below), else GJK/EPA (gjk_epa.hpp);
+//     (below) and for a cylinder's side against a cylinder's side, a capsule or a sphere (the
+//     closest points of the axis segments, detail::side_contact), else GJK/EPA (gjk_epa.hpp);
 //  2. the supporting features of A along n and of B along -n (convex_support.hpp: point, segment
 //     or polygon);
 //  3. the features clipped against each other in the plane perpendicular to n (polygon against
@@ -31,6 +32,7 @@
 
 #include "manisoft/contact/contact_manifold.hpp"
 #include "manisoft/contact/gjk_epa.hpp"
+#include "manisoft/contact/segment_geometry.hpp"
 
 #include <algorithm>
 #include <array>
@@ -201,9 +203,9 @@ inline void reduce_points(const ClipPoints& c, const Vec3& n, ContactSet& out) {
   }
 }
 
-/// The manifold of a pair whose normal and signed distance are known (`d`). Returns true when the
-/// clipped features alone reach the known depth (no witness point needed).
-inline bool contacts_from_features(const ConvexSupport& a, const ConvexSupport& b, const ConvexDistance& d, double margin,
+/// The manifold of a pair whose normal and signed distance are known (`d`). Returns the deepest
+/// separation the clipped features reached by themselves (infinity if none).
+inline double contacts_from_features(const ConvexSupport& a, const ConvexSupport& b, const ConvexDistance& d, double margin,
                                    ContactSet& out) {
   out.clear();
   out.normal = d.normal;
@@ -231,22 +233,19 @@ inline bool contacts_from_features(const ConvexSupport& a, const ConvexSupport& 
   for (int k = 0; k < pts.count; ++k) deepest = std::min(deepest, pts.separation[static_cast<std::size_t>(k)]);
   const double tol = 1e-5 + 0.05 * std::abs(d.separation);
   const Vec3 witness = 0.5 * (d.point_a + d.point_b);
-  bool agree = true;
   if (pts.count == 0 || deepest < d.separation - tol) {
     out.normal_owner = NormalOwner::shape_a;
     out.add(witness, d.separation);
-    agree = false;
   } else {
-    if (deepest > d.separation + tol) {
-      pts.add(witness, d.separation);
-      agree = false;
-    }
+    // Polygons inscribed in a rim (and chords where two of them cross) can stay a little above
+    // the true deepest point: add it when they miss it by more than 1 um.
+    if (deepest > d.separation + 1e-6) pts.add(witness, d.separation);
     reduce_points(pts, d.normal, out);
   }
   // Fewer than three points: a curved surface or an edge carries the contact, and the touching
   // material points change as the bodies roll (re-detect every step while moving).
   out.rolling = out.count < 3;
-  return agree;
+  return deepest;
 }
 
 /// Cylinder against a box face, analytic (see the file comment). Returns 1 with `out` filled,
@@ -290,15 +289,72 @@ inline int cylinder_box_face(const ConvexSupport& cyl, const ConvexSupport& box,
   d.point_b = cylinder_is_a ? Vec3(deep - best * n_box_to_cyl) : deep;
   const ConvexSupport& sa = cylinder_is_a ? cyl : box;
   const ConvexSupport& sb = cylinder_is_a ? box : cyl;
-  // Exact only if the cylinder's deepest part lies over the face: the clipped features (not the
-  // witness point) reach the face separation.
-  if (!contacts_from_features(sa, sb, d, margin, out)) return -1;
-  double deepest = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < out.count; ++k) deepest = std::min(deepest, out.points[static_cast<std::size_t>(k)].separation);
-  if (!(deepest <= best + 1e-9 + 1e-6 * std::abs(best))) return -1;
+  // Exact only if the cylinder's deepest part lies over the face: its support point projects into
+  // the face rectangle, or the clipped features (the deepest point is not unique on a cap or a
+  // side line) reach the face separation.
+  const double clipped = contacts_from_features(sa, sb, d, margin, out);
+  const Vec3 deep_local = rb.transpose() * (deep - box.pose.translation);
+  const int j = (face + 1) % 3, k = (face + 2) % 3;
+  const bool over_face = std::abs(deep_local[j]) <= H[j] && std::abs(deep_local[k]) <= H[k];
+  if (!over_face && !(clipped <= best + 1e-9 + 1e-6 * std::abs(best))) return -1;
   // The face's normal belongs to the box.
   out.normal_owner = cylinder_is_a ? NormalOwner::shape_b : NormalOwner::shape_a;
   return 1;
+}
+
+/// A cylinder's side against another cylinder's side, a capsule or a sphere, analytic: each shape
+/// lies inside the capsule of its axis segment and radius, so the distance is at least that of the
+/// two capsules, |q_b - q_a| - r_a - r_b with q_a, q_b the closest points of the axis segments;
+/// when q_a (and q_b for a cylinder) is interior to its segment, n = (q_b - q_a)/|q_b - q_a| is
+/// perpendicular to that axis and q_a + r_a n, q_b - r_b n lie on the sides: the bound is reached,
+/// the distance exact. For a shallow penetration (depth below half the smaller radius, closest
+/// points at least the depth away from the segment ends) the same normal and depth are used.
+/// Returns false when these conditions fail (GJK/EPA answers).
+inline bool side_contact(const ConvexSupport& a, const ConvexSupport& b, ConvexDistance& d) {
+  auto axis_segment = [](const ConvexSupport& x, Vec3& p0, Vec3& p1, double& radius) {
+    const Vec3 half = x.shape->kind == ShapeKind::sphere ? Vec3::Zero() : Vec3(x.shape->half_length * x.axis());
+    p0 = x.pose.translation - half;
+    p1 = x.pose.translation + half;
+    radius = x.shape->radius;
+  };
+  Vec3 a0, a1, b0, b1;
+  double ra = 0, rb = 0;
+  axis_segment(a, a0, a1, ra);
+  axis_segment(b, b0, b1, rb);
+  auto cp = closest_segment_segment(a0, a1, b0, b1);
+  const Vec3 da = a1 - a0, db = b1 - b0;
+  const double la2 = da.squaredNorm(), lb2 = db.squaredNorm();
+  if (la2 > 0 && lb2 > 0 && da.cross(db).squaredNorm() < 1e-12 * la2 * lb2) {
+    // Parallel axes: every point of the overlap is closest; take the middle of the overlap.
+    double t0 = (b0 - a0).dot(da) / la2, t1 = (b1 - a0).dot(da) / la2;
+    if (t0 > t1) std::swap(t0, t1);
+    t0 = std::max(t0, 0.0);
+    t1 = std::min(t1, 1.0);
+    if (t1 > t0) {
+      cp.s = 0.5 * (t0 + t1);
+      cp.point_a = a0 + cp.s * da;
+      cp.t = std::clamp((cp.point_a - b0).dot(db) / lb2, 0.0, 1.0);
+      cp.point_b = b0 + cp.t * db;
+    }
+  }
+  const Vec3 gap = cp.point_b - cp.point_a;
+  const double dist = gap.norm();
+  if (!(dist > 1e-9)) return false;
+  const double sep = dist - ra - rb;
+  const double depth = std::max(-sep, 0.0);
+  if (depth > 0.5 * std::min(ra, rb)) return false;
+  auto interior = [&](const ConvexSupport& x, double t, const Vec3& p0, const Vec3& p1) {
+    if (x.shape->kind != ShapeKind::cylinder) return true;  // a capsule's surface surrounds its whole segment
+    const double len = (p1 - p0).norm();
+    return std::min(t, 1.0 - t) * len > depth && t > 0.0 && t < 1.0;
+  };
+  if (!interior(a, cp.s, a0, a1) || !interior(b, cp.t, b0, b1)) return false;
+  d.normal = gap / dist;
+  d.separation = sep;
+  d.point_a = cp.point_a + ra * d.normal;
+  d.point_b = cp.point_b - rb * d.normal;
+  d.penetrating = sep < 0;
+  return true;
 }
 
 }  // namespace detail
@@ -317,6 +373,13 @@ inline bool collide_convex(const CollisionShape& a, const Pose& pose_a, const Co
     if (face >= 0) return face == 1 && out.count > 0;
   }
   ConvexDistance d;
+  const bool sided_a = a.kind == ShapeKind::cylinder || a.kind == ShapeKind::capsule || a.kind == ShapeKind::sphere;
+  const bool sided_b = b.kind == ShapeKind::cylinder || b.kind == ShapeKind::capsule || b.kind == ShapeKind::sphere;
+  if (sided_a && sided_b && detail::side_contact(sa, sb, d)) {
+    if (d.separation > margin) return false;
+    detail::contacts_from_features(sa, sb, d, margin, out);
+    return out.count > 0;
+  }
   if (!convex_distance(sa, sb, margin, d)) {
     out.clear();
     return false;
