@@ -13,8 +13,9 @@
 //     either side). So a cylinder standing on its cap gets a polygon of rim points, a cylinder
 //     lying on its side two points at the ends of its contact line (it rolls with no facet bumps),
 //     and a cylinder tilted on its rim one point, each at its exact depth.
-// When the clipped points miss the deepest contact (or are deeper than it, a sign of a badly chosen
-// feature), the GJK/EPA witness point is used instead or added.
+// When the clipped points miss the deepest contact by more than 1 um (polygons inscribed in a rim,
+// chords where two rims cross) the exact witness point (analytic or GJK/EPA) is added; when they
+// are deeper than it (a badly chosen feature) it replaces them.
 //
 // Cylinder (centre c, unit axis a, radius r, half height h) on a box face, in the box frame
 // (half extents H): the face i with outward normal n = sgn(c_i) e_i has separation
@@ -26,8 +27,9 @@
 // cylinder's side, cylinder extent exactly r) are tested too. Every such separation is a lower
 // bound of the true signed distance (separating-axis theorem), so any above the margin means no
 // contact. When a face separation is the largest and the deepest part of the cylinder lies over
-// the face (the clipped feature reaches that depth), it is the exact signed distance and n the
-// exact normal; otherwise (edge and corner contacts) GJK/EPA answers.
+// the face (its support point projects into the face, or the clipped feature reaches that depth),
+// it is the exact signed distance and n the exact normal; otherwise (edge and corner contacts)
+// GJK/EPA answers.
 #pragma once
 
 #include "manisoft/contact/contact_manifold.hpp"
