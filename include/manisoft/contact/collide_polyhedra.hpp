@@ -1,8 +1,8 @@
-// Separating-axis test with face clipping between two convex polyhedra (boxes, cylinder prisms,
-// convex meshes): a multi-point contact manifold, which FCL's GJK/EPA (one point per pair) cannot
-// give. Axes tested: the face normals of both shapes and the cross products of their unique edge
-// directions; the best axis is the one of largest separation, with face axes preferred over edge
-// axes unless an edge axis is clearly better (a face manifold is what keeps a resting box flat).
+// Separating-axis test with face clipping between two convex polyhedra (boxes, convex meshes): a
+// multi-point contact manifold, which FCL's GJK/EPA (one point per pair) cannot give. Axes
+// tested: the face normals of both shapes and the cross products of their unique edge directions;
+// the best axis is the one of largest separation, with face axes preferred over edge axes unless
+// an edge axis is clearly better (a face manifold is what keeps a resting box flat).
 // Face case: the incident face (most anti-parallel to the reference normal) is clipped against the
 // side planes of the reference face (Sutherland-Hodgman); points within the margin are kept and
 // reduced to the 4 that span the largest area. Edge case: the closest points of the two edges.

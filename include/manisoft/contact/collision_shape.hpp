@@ -1,6 +1,7 @@
 // The collision-side description of one primitive shape: its kind, sizes, its polyhedron (box,
-// cylinder prism, convex mesh) for the separating-axis narrow phase, and its FCL geometry for the
-// FCL broad phase and the FCL fallback pairs.
+// convex mesh; a cylinder's prism is kept for callers that want a polyhedron, the narrow phase
+// uses the true cylinder) for the separating-axis narrow phase, and its FCL geometry for the FCL
+// broad phase.
 #pragma once
 
 #include "manisoft/contact/contact_point.hpp"

@@ -62,6 +62,7 @@ struct ContactManifold {
   PatchFriction patch{};
   double travel_a{0}, travel_b{0};  ///< body travel when last detected
   bool fresh{true};                 ///< never run through the narrow phase
+  bool rolling{false};              ///< last detection was a rolling contact (ContactSet::rolling)
   // Per step.
   Vec3 normal{Vec3::UnitZ()}, tangent1{Vec3::UnitX()}, tangent2{Vec3::UnitY()};
   bool active{false};
@@ -77,7 +78,7 @@ struct ManifoldMemory {
   std::uint32_t geom_a{0}, geom_b{0}, body_a{0}, body_b{0};
   Vec3 normal_local{Vec3::UnitZ()};
   NormalOwner owner{NormalOwner::shape_a};
-  bool fresh{true};
+  bool fresh{true}, rolling{false};
   int count{0};
   double friction{0.5}, restitution{0}, travel_a{0}, travel_b{0};
   struct Point {
@@ -97,6 +98,7 @@ struct ManifoldMemory {
     r.normal_local = m.normal_local;
     r.owner = m.owner;
     r.fresh = m.fresh;
+    r.rolling = m.rolling;
     r.count = m.count;
     r.friction = m.friction;
     r.restitution = m.restitution;
@@ -122,6 +124,7 @@ struct ManifoldMemory {
     m.normal_local = normal_local;
     m.owner = owner;
     m.fresh = fresh;
+    m.rolling = rolling;
     m.count = count;
     m.friction = friction;
     m.restitution = restitution;

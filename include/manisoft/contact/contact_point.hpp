@@ -37,8 +37,14 @@ struct ContactSet {
   NormalOwner normal_owner{NormalOwner::shape_a};
   int count{0};
   std::array<ContactPoint, kMaxContactPoints> points{};
+  /// The touching points are not fixed material points (a curved surface or an edge carries the
+  /// contact): a cached manifold would drift as the bodies roll, so re-detect it every step.
+  bool rolling{false};
 
-  void clear() { count = 0; }
+  void clear() {
+    count = 0;
+    rolling = false;
+  }
   void add(const Vec3& position, double separation) {
     if (count < kMaxContactPoints) points[static_cast<std::size_t>(count++)] = {position, separation};
   }

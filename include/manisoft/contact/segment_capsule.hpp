@@ -2,7 +2,7 @@
 // without allocating: the collision shape, its pose (local z along the segment, local x from a
 // reference direction such as the element's d1, so the frame follows the material), and the
 // segment parameter t in [0, 1] of a point, x = p0 + t (p1 - p0), that splits a contact force on
-// the two end nodes. The FCL capsule behind it (broad phase and FCL fallback pairs) is created
+// the two end nodes. The FCL capsule behind it (for an FCL broad-phase query) is created
 // once and resized in place.
 #pragma once
 

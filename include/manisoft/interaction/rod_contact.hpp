@@ -50,9 +50,9 @@
 // their union; a body is skipped unless its bounding sphere's box meets the union; a geometry
 // unless its bounds meet the union; then each element whose box meets the geometry's bounds goes
 // to the narrow phase (contact/narrow_phase.hpp: analytic capsule-sphere/capsule/box, SAT is not
-// used for capsules, FCL for capsule vs cylinder or mesh). No heap allocation in steady state
-// except on the FCL fallback path (FCL's result vectors), as in RigidWorld. The anchors are
-// looked up by (geometry, slot) in the element's slots in a fixed order: deterministic.
+// used for capsules, support-function GJK/EPA for capsule vs cylinder or mesh). No heap
+// allocation in steady state, as in RigidWorld. The anchors are looked up by (geometry, slot) in
+// the element's slots in a fixed order: deterministic.
 #pragma once
 
 #include <algorithm>

@@ -8,11 +8,11 @@
 // Step order (symplectic Euler): contacts -> prepare -> v += h M^-1 f -> warm start -> solve ->
 // x += h v, q += h/2 w q -> relax -> restitution -> store.
 // Determinism: everything is iterated in body/geometry index order; broad-phase pairs are sorted.
-// Allocation: after the first steps (buffers grown to their working size) step() allocates only on
-// the FCL fallback path (FCL result vectors) and when the set of overlapping pairs grows beyond its
-// previous maximum; query_capsule allocates only on first use (BENCHMARKS.md has the counts).
-// Rollback: step() snapshots everything it changes (Snapshot) and restores it when a body's state
-// turns non-finite; assemblies that snapshot several parts at once call advance() instead.
+// Allocation: after the first steps (buffers grown to their working size) step() allocates only
+// when the set of overlapping pairs grows beyond its previous maximum (the narrow phase works in
+// fixed-size buffers; query_capsule allocates only on first use).
+// Rollback: step() records what it changes (begin_step) and puts it back (undo_step) when a
+// body's state turns non-finite; save() / restore() snapshot the whole world at any time.
 #pragma once
 
 #include "manisoft/contact/contact_solver.hpp"
@@ -563,14 +563,15 @@ class RigidWorld {
       auto& m = manifolds_[i];
       const auto& sa = states_[m.body_a];
       const auto& sb = states_[m.body_b];
-      // Analytic pairs with a rounded shape are re-evaluated every step while a body moves: they
-      // cost well under a microsecond, and a rolling sphere's contact is not a material point
-      // (the cached extrapolation would let it sink). SAT and FCL pairs use the cache.
+      // Analytic pairs with a rounded shape, and pairs whose last contact was a rolling one
+      // (a cylinder on its side or rim), are re-evaluated every step while a body moves: a rolling
+      // body's contact is not a material point (the cached extrapolation would let it sink and
+      // would move the lever arm). Face contacts (SAT, a cylinder on its cap) use the cache.
       const auto ka = geoms_[m.geom_a].shape.kind, kb = geoms_[m.geom_b].shape.kind;
       const bool analytic_round = (is_round(ka) && (is_round(kb) || kb == contact::ShapeKind::box)) ||
                                   (is_round(kb) && ka == contact::ShapeKind::box);
       const bool moving = is_moving(m.body_a) || is_moving(m.body_b);
-      if (!m.fresh && !(analytic_round && moving) && (sa.travel - m.travel_a) + (sb.travel - m.travel_b) <= redetect) continue;
+      if (!m.fresh && !((analytic_round || m.rolling) && moving) && (sa.travel - m.travel_a) + (sb.travel - m.travel_b) <= redetect) continue;
       record_manifold(i);
       m.fresh = false;
       m.travel_a = sa.travel;
@@ -602,6 +603,7 @@ class RigidWorld {
     const double match2 = std::pow(std::max(settings_.contact_margin, 1e-3), 2);
     if (!same_normal) m.patch = {};  // a new contact (or a flipped normal): no friction history
     m.count = c.count;
+    m.rolling = c.rolling;
     m.owner = c.normal_owner;
     m.normal_local = (c.normal_owner == contact::NormalOwner::shape_a ? sa.rotation : sb.rotation).transpose() * c.normal;
     for (int k = 0; k < c.count; ++k) {
