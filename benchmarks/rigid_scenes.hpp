@@ -104,6 +104,7 @@ inline Scene build(rigid::RigidWorld& w, const std::string& name) {
 struct Outcome {
   double max_xy_drift{0};   ///< m, largest horizontal displacement of any watched body
   double max_sink{0};       ///< m, largest downward displacement (positive = sank)
+  double max_rise{0};       ///< m, largest upward displacement (a body popping out of contact)
   double max_tilt_deg{0};
   int ejected{0};           ///< bodies that left the table or fell below it
   std::string worst;
@@ -126,6 +127,7 @@ struct Tracker {
       const double xy = std::hypot(d.x(), d.y());
       if (xy > out.max_xy_drift) { out.max_xy_drift = xy; out.worst = s.names[i]; }
       out.max_sink = std::max(out.max_sink, -d.z());
+      out.max_rise = std::max(out.max_rise, d.z());
       out.max_tilt_deg = std::max(out.max_tilt_deg, w.orientation(s.bodies[i]).angularDistance(start_q[i]) * 180 / std::numbers::pi);
     }
   }

@@ -62,9 +62,12 @@ TEST_CASE("a box resting on the table neither sinks nor drifts", "[world][rest]"
     }
   }
   t.finish(w, s);
-  INFO("penetration " << max_pen << " m, drift " << t.out.max_xy_drift << " m, sink " << t.out.max_sink);
+  INFO("penetration " << max_pen << " m, drift " << t.out.max_xy_drift << " m, sink " << t.out.max_sink << " m, rise "
+                       << t.out.max_rise << " m, tilt " << t.out.max_tilt_deg << " deg");
   CHECK(max_pen < 0.5e-3);
   CHECK(t.out.max_sink < 0.5e-3);
+  CHECK(t.out.max_rise < 0.1e-3);
+  CHECK(t.out.max_tilt_deg < 0.05);
   CHECK(t.out.max_xy_drift < 0.1e-3);
 }
 
@@ -121,9 +124,11 @@ TEST_CASE("a stack of five boxes stands", "[world][stack][slow]") {
   rigid::RigidWorld w(awake_settings());
   const auto s = scenes::build(w, "S2");
   const auto out = run(w, s, 10.0);
-  INFO("drift " << out.max_xy_drift << " sink " << out.max_sink << " tilt " << out.max_tilt_deg);
+  INFO("drift " << out.max_xy_drift << " sink " << out.max_sink << " rise " << out.max_rise << " tilt " << out.max_tilt_deg);
   CHECK(out.max_xy_drift < 2e-3);
   CHECK(out.max_sink < 0.5e-3);
+  CHECK(out.max_rise < 0.5e-3);      // no body pops up out of its contact
+  CHECK(out.max_tilt_deg < 0.5);     // and none tips over
   CHECK(out.ejected == 0);
 }
 
@@ -136,9 +141,11 @@ TEST_CASE("three cylinders stacked 5 mm off-centre stand", "[world][stack][slow]
     s.names.push_back("cyl" + std::to_string(k));
   }
   const auto out = run(w, s, 10.0);
-  INFO("drift " << out.max_xy_drift << " sink " << out.max_sink << " tilt " << out.max_tilt_deg);
+  INFO("drift " << out.max_xy_drift << " sink " << out.max_sink << " rise " << out.max_rise << " tilt " << out.max_tilt_deg);
   CHECK(out.max_xy_drift < 2e-3);
   CHECK(out.max_sink < 0.5e-3);
+  CHECK(out.max_rise < 0.5e-3);      // no body pops up out of its contact
+  CHECK(out.max_tilt_deg < 0.5);     // and none tips over
   CHECK(out.ejected == 0);
 }
 
@@ -152,9 +159,11 @@ TEST_CASE("four nested bowls rest in each other", "[world][stack][compound][slow
     s.names.push_back("bowl" + std::to_string(k));
   }
   const auto out = run(w, s, 10.0);
-  INFO("drift " << out.max_xy_drift << " sink " << out.max_sink << " tilt " << out.max_tilt_deg);
+  INFO("drift " << out.max_xy_drift << " sink " << out.max_sink << " rise " << out.max_rise << " tilt " << out.max_tilt_deg);
   CHECK(out.max_xy_drift < 2e-3);
   CHECK(out.max_sink < 0.5e-3);
+  CHECK(out.max_rise < 0.5e-3);      // no body pops up out of its contact
+  CHECK(out.max_tilt_deg < 0.5);     // and none tips over
   CHECK(out.ejected == 0);
 }
 

@@ -116,6 +116,7 @@ TEST_CASE("float reproduces the n = 20 reference trajectories within float toler
     if (sc.n != 20) continue;
     CAPTURE(sc.name);
     const auto [pos_err, dir_err] = replay<float>(sc);
+    WARN("FLOATERR " << sc.name << " " << pos_err << " " << dir_err);
     // float accumulates ~1e-7 relative round-off per step over 1e4 steps.
     CHECK(pos_err < 2e-3);
     CHECK(dir_err < 2e-3);

@@ -107,8 +107,13 @@ TEST_CASE("opening releases the object onto the table", "[world][gripper]") {
   s.run(Vector3d(0, 0, 0.2), 0.5);  // lift 10 cm
   const double lifted = s.world.center_of_mass(s.cube).z();
   s.gripper.command(0);
+  CHECK_FALSE(s.gripper.released_now());
+  s.step(Vector3d::Zero());
+  CHECK(s.gripper.released_now());  // the event is reported in the step it happens ...
+  CHECK_FALSE(s.gripper.slipped());
+  s.step(Vector3d::Zero());
+  CHECK_FALSE(s.gripper.released_now());  // ... and only in that step
   s.run(Vector3d::Zero(), 0.02);
-  CHECK(s.gripper.released_now() == false);  // the event is reported in the step it happens
   CHECK_FALSE(s.gripper.held());
   CHECK(s.gripper.last_released() == s.cube);
   s.run(Vector3d::Zero(), 0.6);  // free fall of 7.5 cm (0.12 s), then rest
