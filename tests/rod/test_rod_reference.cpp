@@ -116,10 +116,27 @@ TEST_CASE("float reproduces the n = 20 reference trajectories within float toler
     if (sc.n != 20) continue;
     CAPTURE(sc.name);
     const auto [pos_err, dir_err] = replay<float>(sc);
-    WARN("FLOATERR " << sc.name << " " << pos_err << " " << dir_err);
-    // float accumulates ~1e-7 relative round-off per step over 1e4 steps.
-    CHECK(pos_err < 2e-3);
-    CHECK(dir_err < 2e-3);
+    // Bounds about 3x the float error measured per scenario (g++ 12 Release; tip position m,
+    // directors): float's ~1e-7 relative round-off per step, accumulated differently by each
+    // motion. A scenario not listed (a newer reference folder) gets the loose 2e-3 bound.
+    struct Bound {
+      const char* name;
+      double position, directors;
+    };
+    constexpr Bound bounds[] = {{"a_gravity_n20", 7e-4, 9e-4},          // measured 2.3e-4, 2.9e-4
+                                {"a_gravity_static_n20", 2e-5, 3.5e-5},   // 6.4e-6, 1.1e-5
+                                {"b_torque1_lab_n20", 4e-5, 5e-5},        // 1.3e-5, 1.5e-5
+                                {"b_torque20_lab_n20", 2.5e-4, 3.5e-4},   // 8.4e-5, 1.1e-4
+                                {"b_torque20_lab_static_n20", 2.5e-5, 3e-5}};  // 7.9e-6, 8.9e-6
+    double pos_bound = 2e-3, dir_bound = 2e-3;
+    for (const auto& b : bounds)
+      if (sc.name == b.name) {
+        pos_bound = b.position;
+        dir_bound = b.directors;
+      }
+    CAPTURE(pos_err, dir_err, pos_bound, dir_bound);
+    CHECK(pos_err < pos_bound);
+    CHECK(dir_err < dir_bound);
     ++checked;
   }
   REQUIRE(checked >= 5);

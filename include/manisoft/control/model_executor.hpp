@@ -1,4 +1,4 @@
-// Model-based executor (issue 4 part 4; DESIGN.md section 8): inverse statics feed-forward, node
+// Model-based executor (the low-level executor of the ManiSoft paper, section 3.4): inverse statics feed-forward, node
 // velocity and position feedback mapped to element torques, an online estimate of the arm's
 // stiffness scale, and an outer loop on the measured end-effector pose.
 //
@@ -11,10 +11,8 @@
 // Per control step, action = clamp(tau_ff + tau_fb), element 0 (clamped) = 0; from the tip
 // inwards, what the clamp cuts off an element is added to the next proximal element
 // (carry_saturation): the couple carried across every other node is then still the one asked for
-// (sum_{j >= k} tau_j), only the node between the two elements sees the difference. Measured on
-// table targets whose feed-forward needs > 90% of the limit: without the carry a few reached the
-// tolerance and later slipped into a slow saturated oscillation (final errors up to 65 mm over
-// 300 targets x 4 conditions), with it the largest final error is 7.7 mm.
+// (sum_{j >= k} tau_j), only the node between the two elements sees the difference (without it,
+// targets near the limits slip into a slow saturated oscillation; BENCHMARKS.md, "Executor").
 //   tau_ff    the inverse statics feed-forward of the current shape target (inverse_statics.hpp),
 //             with the elastic part scaled by the stiffness estimate s_hat;
 //   tau_fb    node forces F_j = -m_j (kd v_j + kp (x_j - x*_j)) (positions and velocities of
@@ -28,25 +26,22 @@
 //             tangent onto the observed one. The position term matters beyond steady-state
 //             accuracy: the feed-forward torques are follower (material-frame) loads, and on
 //             strongly curled shapes the equilibrium they hold flutters unless the feedback is
-//             stiff enough (measured: kp = 200 /s^2, kd = 25 /s lost 2-3% of table targets to
-//             growing oscillations; kp = 800, kd = 35 with the twist term and the ramp below
-//             none on table seeds 1-6).
+//             stiff enough (the gains' choice: BENCHMARKS.md, "Executor").
 //   twist     the position feedback cannot see twist: a twist couple -k_tw phi (s_k / L) on every
 //             element, phi the twist of the observed end-effector frame about the tip tangent
-//             relative to the estimated tip frame, holds the twist of curled shapes (measured:
-//             without it some strongly curled table targets slowly twisted off to another
-//             equilibrium branch; k_tw = 20 N m/rad).
+//             relative to the estimated tip frame, holds the twist of curled shapes (without it
+//             strongly curled shapes can twist off to another equilibrium branch).
 //   ramp      a new target's shape is reached through the coefficient blend of the old and new
 //             inverse statics solutions (smoothstep) over max(ramp_steps, tip path / ramp_max_speed)
-//             control steps (at most max_ramp_steps): a blend whose tip sweeps a long path
-//             (measured up to 3.2 m for a 1 m arm) is slowed so the arm can follow it.
+//             control steps (at most max_ramp_steps): a blend whose tip sweeps a long path (it
+//             can be several times the arm's length) is slowed so the arm can follow it.
 //   stiffness estimate (after the ramp, while every observed node is slower than
 //             estimate_speed_gate and no actuator saturates): a stiffness error s/s_hat bends the arm, to first order, to
 //             the curvature (s_hat/s) c* of the desired one. Every `outer_period` steps the
 //             observed node deviations (and the tip rotation deviation) averaged over the period
 //             are regressed on the shape change of a relative curvature scaling, beta, and
 //             s_hat <- s_hat (1 - g beta). With the right s_hat the desired shape is again an exact
-//             equilibrium of the arm (measured: Young's modulus +-10% leaves no static error).
+//             equilibrium of the arm.
 //   outer loop every `outer_period` control steps while quasi-static: with the pose error
 //             averaged over the period, e_p = p* - p, e_R = log(R* R^T) (lab), the shape target
 //             moves by  p_s <- p_s + K e_p,  R_s <- Exp(K e_R) R_s,  and the inverse statics is
@@ -88,7 +83,7 @@ struct ModelExecutorSettings {
   Scalar max_stiffness_scale = Scalar(2);
   Scalar twist_gain = Scalar(20);          ///< N m/rad: twist couple -k phi_tip (s_k / L) on the tip twist error
   Scalar twist_damping = Scalar(0);        ///< N m s/rad: twist couple -c w_tip (s_k / L) from end-effector
-                                           ///< pose differences (measured: no gain at 0.1-0.5, 2 destabilizes)
+                                           ///< pose differences (0: off; BENCHMARKS.md has the runs)
 };
 
 template <typename ScalarType>

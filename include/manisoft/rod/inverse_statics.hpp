@@ -1,4 +1,5 @@
-// Inverse statics of a clamped Cosserat rod arm (issue 4 part 3; DESIGN.md section 8): finds a
+// Inverse statics of a clamped Cosserat rod arm (discrete Cosserat rod of Gazzola et al. 2018 as
+// in PyElastica; used by the ManiSoft executor, paper section 3.4): finds a
 // static shape whose tip frame (last node, last element's directors) is a target SE(3) pose, and
 // the material-frame element torques that make that shape an exact equilibrium of the discrete
 // rod of rod/internal_forces.hpp.
@@ -12,7 +13,8 @@
 // node j > k plus the payload m_p g on the tip node), n_k = S (e_k Q_k t_k - e3) with
 // n_k = e_k Q_k (that force), solved for u_k = e_k Q_k t_k by fixed-point iteration, and
 // x_{k+1} = x_k + l0_k Q_k^T u_k. Gravity and the payload then enter the torque balance through
-// the shear couple (Q t x n) l0 exactly as in the simulated rod (DESIGN.md section 8).
+// the shear couple (Q t x n) l0 exactly as in the simulated rod (a shape built without shear
+// would drop gravity from the torques).
 //
 // Feed-forward. tau_ff = -(internal torque of the rod at the desired state, zero velocities):
 // every element except the clamped one is in exact torque balance and every free node in exact
@@ -28,9 +30,9 @@
 // returned shape meets the target to ~1e-12 m. The Jacobian is analytic (below). Warm start:
 // solve() starts from the previous solution. Cold targets (solve_cold) start from the entries of
 // a start library whose tip poses are nearest the target (1500 deterministic random curvature
-// profiles within the actuation limits, built at construction, ~10 ms), then the previous
-// solution and the straight shape, on a budget of LM iterations over all starts; measured on
-// table targets: mean ~0.45 ms, max ~1.5 ms CPU time per cold solve.
+// profiles within the actuation limits, built at construction), then the previous solution and
+// the straight shape, on a budget of LM iterations over all starts (costs: BENCHMARKS.md,
+// "Executor").
 // Model estimates (set_model_estimates): the feed-forward can assume a stiffness scale and a
 // payload other than the model's without re-solving the shape (used by the model executor).
 // No heap allocation after construction.
