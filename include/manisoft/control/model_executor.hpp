@@ -139,59 +139,11 @@ class ModelExecutor {
     if (action.rows() != n) action.resize(n, 3);  // allocates only if the caller passed a wrong size
     if (!has_target_ || !same_pose(o.target, target_)) set_target(o.target);
     interpolate(o);
-    if (steps_ < ramp_steps_) {
-      // Quasi-static ramp: every intermediate shape is an exact equilibrium of the model.
-      const Scalar x = Scalar(steps_ + 1) / Scalar(ramp_steps_);
-      const Scalar blend = x * x * (Scalar(3) - Scalar(2) * x);
-      statics_.set_coefficients(ramp_start_ + blend * (ramp_end_ - ramp_start_));
-    } else {
-      outer_loop(o);
-    }
-    // Twist rate at the tip from successive end-effector poses (lab angular velocity . d3).
-    Scalar tip_twist_rate = 0;
-    if (has_previous_ && o.time > previous_time_) {
-      const Vector3 w = math::so3::log(Matrix3(o.end_effector.rotation * previous_rotation_.transpose())) / (o.time - previous_time_);
-      if (w.allFinite()) tip_twist_rate = w.dot(o.end_effector.rotation.col(2));
-    }
-    previous_rotation_ = o.end_effector.rotation;
-    previous_time_ = o.time;
-    has_previous_ = true;
+    advance_shape_target(o);
+    const Scalar twist_rate = tip_twist_rate(o);
     const bool adapting = settings_.stiffness_gain > Scalar(0) && steps_ >= ramp_steps_ + settings_.estimate_delay &&
                           o.node_velocities.rowwise().norm().maxCoeff() <= settings_.estimate_speed_gate;
-    // Velocity damping as element couples through the lever arms of the nodes beyond each element.
-    const Array3& ff = statics_.feedforward();
-    const rod::RodState<Scalar>& desired = statics_.desired_state();
-    const auto& limits = statics_.limits();
-    Vector3 distal = Vector3::Zero();
-    Vector3 excess = Vector3::Zero();  // clamped-off torque carried to the next proximal element
-    Scalar tip_twist = 0;
-    bool saturated = false;
-    for (int k = n - 1; k >= 0; --k) {
-      distal -= node_mass_[k + 1] * (settings_.damping_gain * velocities_.row(k + 1).transpose() +
-                                     settings_.position_gain * (positions_.row(k + 1) - desired.positions.row(k + 1)).transpose());
-      const Vector3 lever = (positions_.row(k + 1) - positions_.row(k)).transpose();
-      // Material frame of element k estimated from the desired one, turned by the smallest
-      // rotation that takes the desired element tangent onto the observed one.
-      const Vector3 desired_lever = (desired.positions.row(k + 1) - desired.positions.row(k)).transpose();
-      const Matrix3 turn = Eigen::Quaternion<Scalar>::FromTwoVectors(desired_lever, lever).toRotationMatrix();
-      const Matrix3 frame = desired.director(k) * turn.transpose();  // lab -> estimated material
-      if (k == n - 1) {
-        // Twist of the observed tip frame about the tip tangent relative to the estimated one.
-        const Vector3 d = math::so3::log(Matrix3(o.end_effector.rotation * frame));
-        tip_twist = d.allFinite() ? d.dot(lever.normalized()) : Scalar(0);
-      }
-      Vector3 couple = frame * lever.cross(distal);
-      const Scalar share = (Scalar(k) + Scalar(0.5)) / Scalar(n);
-      couple[2] -= share * (settings_.twist_gain * tip_twist + settings_.twist_damping * tip_twist_rate);
-      for (int i = 0; i < 3; ++i) {
-        const Scalar lim = limits.limit(i);
-        const Scalar a = ff(k, i) + couple[i] + (settings_.carry_saturation ? excess[i] : Scalar(0));
-        if (k > 0 && std::abs(a) > lim) saturated = true;
-        action(k, i) = std::clamp(a, -lim, lim);
-        excess[i] = a - action(k, i);
-      }
-    }
-    action.row(0).setZero();
+    const bool saturated = feedforward_plus_feedback(o, twist_rate, action);
     // A saturated actuator does not apply the torque the estimate assumes: no update then.
     if (adapting && !saturated) accumulate_estimate(o);
     ++steps_;
@@ -239,6 +191,72 @@ class ModelExecutor {
   Scalar stiffness_estimate() const { return statics_.stiffness_scale(); }
 
  private:
+  /// Stage 1: the shape target of this step: along the ramp (every intermediate shape an exact
+  /// equilibrium of the model), then the outer loop's corrections.
+  void advance_shape_target(const Observation<Scalar>& o) {
+    if (steps_ < ramp_steps_) {
+      const Scalar x = Scalar(steps_ + 1) / Scalar(ramp_steps_);
+      const Scalar blend = x * x * (Scalar(3) - Scalar(2) * x);
+      statics_.set_coefficients(ramp_start_ + blend * (ramp_end_ - ramp_start_));
+    } else {
+      outer_loop(o);
+    }
+  }
+
+  /// Stage 2: twist rate at the tip from successive end-effector poses (lab angular velocity . d3).
+  Scalar tip_twist_rate(const Observation<Scalar>& o) {
+    Scalar rate = 0;
+    if (has_previous_ && o.time > previous_time_) {
+      const Vector3 w = math::so3::log(Matrix3(o.end_effector.rotation * previous_rotation_.transpose())) / (o.time - previous_time_);
+      if (w.allFinite()) rate = w.dot(o.end_effector.rotation.col(2));
+    }
+    previous_rotation_ = o.end_effector.rotation;
+    previous_time_ = o.time;
+    has_previous_ = true;
+    return rate;
+  }
+
+  /// Stage 3: feed-forward plus the node feedback turned into element couples through the lever
+  /// arms of the nodes beyond each element, the twist couple, clamped with the saturation carry.
+  /// Returns whether an actuated element saturated.
+  bool feedforward_plus_feedback(const Observation<Scalar>& o, Scalar twist_rate, Array3& action) const {
+    const int n = statics_.n_elements();
+    const Array3& ff = statics_.feedforward();
+    const rod::RodState<Scalar>& desired = statics_.desired_state();
+    const auto& limits = statics_.limits();
+    Vector3 distal = Vector3::Zero();
+    Vector3 excess = Vector3::Zero();  // clamped-off torque carried to the next proximal element
+    Scalar tip_twist = 0;
+    bool saturated = false;
+    for (int k = n - 1; k >= 0; --k) {
+      distal -= node_mass_[k + 1] * (settings_.damping_gain * velocities_.row(k + 1).transpose() +
+                                     settings_.position_gain * (positions_.row(k + 1) - desired.positions.row(k + 1)).transpose());
+      const Vector3 lever = (positions_.row(k + 1) - positions_.row(k)).transpose();
+      // Material frame of element k estimated from the desired one, turned by the smallest
+      // rotation that takes the desired element tangent onto the observed one.
+      const Vector3 desired_lever = (desired.positions.row(k + 1) - desired.positions.row(k)).transpose();
+      const Matrix3 turn = Eigen::Quaternion<Scalar>::FromTwoVectors(desired_lever, lever).toRotationMatrix();
+      const Matrix3 frame = desired.director(k) * turn.transpose();  // lab -> estimated material
+      if (k == n - 1) {
+        // Twist of the observed tip frame about the tip tangent relative to the estimated one.
+        const Vector3 d = math::so3::log(Matrix3(o.end_effector.rotation * frame));
+        tip_twist = d.allFinite() ? d.dot(lever.normalized()) : Scalar(0);
+      }
+      Vector3 couple = frame * lever.cross(distal);
+      const Scalar share = (Scalar(k) + Scalar(0.5)) / Scalar(n);
+      couple[2] -= share * (settings_.twist_gain * tip_twist + settings_.twist_damping * twist_rate);
+      for (int i = 0; i < 3; ++i) {
+        const Scalar lim = limits.limit(i);
+        const Scalar a = ff(k, i) + couple[i] + (settings_.carry_saturation ? excess[i] : Scalar(0));
+        if (k > 0 && std::abs(a) > lim) saturated = true;
+        action(k, i) = std::clamp(a, -lim, lim);
+        excess[i] = a - action(k, i);
+      }
+    }
+    action.row(0).setZero();
+    return saturated;
+  }
+
   static bool same_pose(const Pose& a, const Pose& b) {
     return a.translation == b.translation && a.rotation == b.rotation;
   }
@@ -282,7 +300,7 @@ class ModelExecutor {
       den += u.dot(u);
     }
     const Scalar w = statics_.settings().rotation_weight;
-    const Matrix3 desired_tip = desired.director(statics_.n_elements() - 1).transpose();
+    const Matrix3 desired_tip = desired.tip_pose().rotation;
     const Vector3 dr = math::so3::log(Matrix3(o.end_effector.rotation * desired_tip.transpose()));
     num += w * w * direction_tip_.dot(dr);
     den += w * w * direction_tip_.squaredNorm();

@@ -294,6 +294,27 @@ class InverseStatics {
     if (!start.allFinite()) manisoft::detail::fail("InverseStatics: the start coefficients are not finite");
     Coefficients c = start;
     Residual r = residual(c, target);
+    const int lm_it = levenberg_marquardt(target, max_iterations, c, r);
+    int it = lm_it;
+    // A start whose LM did not get near a solution is not worth polishing (solve_cold moves on).
+    if (r.norm() < settings_.polish_threshold) it += polish(target, c, r);
+    it += newton(target, c, r);
+    shape(c);
+    coefficients_ = c;
+    commit();
+    InverseStaticsResult<Scalar> result;
+    result.position_error = r.template head<3>().norm();
+    result.rotation_error = r.template tail<3>().norm() / settings_.rotation_weight;
+    result.iterations = it;
+    result.lm_iterations = lm_it;
+    result.converged = std::isfinite(r.norm()) && r.norm() < settings_.accept_error;
+    result.max_torque_ratio = max_torque_ratio();
+    result.within_limits = result.converged && result.max_torque_ratio <= Scalar(1);
+    return result;
+  }
+
+  /// Stage 1: Levenberg-Marquardt on the regularized objective from c; returns its iterations.
+  int levenberg_marquardt(const Pose& target, int max_iterations, Coefficients& c, Residual& r) {
     Scalar cost = objective(r, c, settings_.regularization);
     Scalar lambda = Scalar(1e-3);
     int it = 0;
@@ -325,16 +346,19 @@ class InverseStatics {
       }
       if (!improved || stalled) break;
     }
-    const int lm_it = it;
-    // Polish: Gauss-Newton steps on the constraint r = 0 that also minimize the effort norm of
-    // the new point (SQP on  min c^T W c  s.t. r(c) = 0):
-    //   c+ = argmin |c + d|_W  s.t.  J d = -r   =>   c+ = W^-1 J^T (J W^-1 J^T)^-1 (J c - r).
-    // This removes mu's bias and slides along the 3-dimensional solution manifold to the least
-    // effortful shape near the LM solution. A step is kept while the residual stays small.
+    return it;
+  }
+
+  /// Stage 2 (polish): Gauss-Newton steps on the constraint r = 0 that also minimize the effort
+  /// norm of the new point (SQP on  min c^T W c  s.t. r(c) = 0):
+  ///   c+ = argmin |c + d|_W  s.t.  J d = -r   =>   c+ = W^-1 J^T (J W^-1 J^T)^-1 (J c - r).
+  /// This removes mu's bias and slides along the 3-dimensional solution manifold to the least
+  /// effortful shape near the LM solution. A step is kept while the residual stays small.
+  /// Returns its iterations.
+  int polish(const Pose& target, Coefficients& c, Residual& r) {
     const Scalar residual_cap = std::max(Scalar(10) * r.norm(), Scalar(1e-4));
-    // A start whose LM did not get near a solution is not worth polishing (solve_cold moves on).
-    const int polish = r.norm() < settings_.polish_threshold ? settings_.polish_iterations : 0;
-    for (int p = 0; p < polish; ++p, ++it) {
+    int p = 0;
+    for (; p < settings_.polish_iterations; ++p) {
       jacobian(c, r, target);
       const Eigen::Matrix<Scalar, n_coefficients, 6> wj = regularizer_inverse_ * jacobian_.transpose();
       const Eigen::Matrix<Scalar, 6, 6> m = jacobian_ * wj;
@@ -352,8 +376,14 @@ class InverseStatics {
       r = r_trial;
       if (done) break;
     }
-    // Final Newton steps (minimum-W-norm step) so the shape meets the target to round-off.
-    for (int p = 0; p < 3 && r.norm() > settings_.tolerance; ++p, ++it) {
+    return p;
+  }
+
+  /// Stage 3: final Newton steps (minimum-W-norm step) so the shape meets the target to
+  /// round-off; returns its iterations.
+  int newton(const Pose& target, Coefficients& c, Residual& r) {
+    int p = 0;
+    for (; p < 3 && r.norm() > settings_.tolerance; ++p) {
       jacobian(c, r, target);
       const Eigen::Matrix<Scalar, n_coefficients, 6> wj = regularizer_inverse_ * jacobian_.transpose();
       const Eigen::Matrix<Scalar, 6, 6> m = jacobian_ * wj;
@@ -363,20 +393,8 @@ class InverseStatics {
       c = trial;
       r = r_trial;
     }
-    shape(c);
-    coefficients_ = c;
-    commit();
-    InverseStaticsResult<Scalar> result;
-    result.position_error = r.template head<3>().norm();
-    result.rotation_error = r.template tail<3>().norm() / settings_.rotation_weight;
-    result.iterations = it;
-    result.lm_iterations = lm_it;
-    result.converged = std::isfinite(r.norm()) && r.norm() < settings_.accept_error;
-    result.max_torque_ratio = max_torque_ratio();
-    result.within_limits = result.converged && result.max_torque_ratio <= Scalar(1);
-    return result;
+    return p;
   }
-
 
  public:
   /// Online model corrections (model executor): the feed-forward assumes the elastic torques
@@ -428,9 +446,7 @@ class InverseStatics {
   /// Feed-forward material-frame element torques, n x 3 (row 0, the clamped element, is 0).
   const Array3& feedforward() const { return feedforward_; }
   /// The desired shape's tip pose (body to lab).
-  Pose desired_tip_pose() const {
-    return Pose{state_.director(n_elements() - 1).transpose(), state_.tip_position()};
-  }
+  Pose desired_tip_pose() const { return state_.tip_pose(); }
   /// Curvature at Voronoi point k of coefficients c (material frame, 1/m).
   Vector3 curvature(const Coefficients& c, int k) const {
     const Scalar s = sigma_[k];
