@@ -10,9 +10,11 @@
 //      unit scale (sidecar "scale"), the up-axis rotation (file up axis -> +z; y-up files turn
 //      +90 degrees about x) and, unless "origin": "keep", the shift that puts the origin at the
 //      centre of the footprint (bounding-box centre in x, y; lowest point z = 0), asset.hpp's frame.
-//   3. The solid: all parts' triangles welded by position. If closed (every edge used once each way),
-//      volume, centre of mass and inertia are the exact polyhedral integrals of the mesh
-//      (geometry::mass_properties); else those of the collision shape.
+//   3. The solid: all parts' triangles welded by position. If closed (every edge used once each way)
+//      and physically sound (volume within the hull's, inertia of a real body), volume, centre of
+//      mass and inertia are the exact polyhedral integrals of the mesh (geometry::mass_properties);
+//      else (open, self-intersecting) those of the collision shape, and ImportReport::note says so.
+//      Overlapping closed shells that stay within the hull are counted twice where they overlap.
 //   4. Collision: the sidecar's convex decomposition when given (files, mesh parts or point sets,
 //      each piece its convex hull); else the convex hull when (V_hull - V) / V <= convex_tolerance
 //      or the surface is open; else geometry::approximate_convex_decomposition (recursive plane
@@ -42,6 +44,7 @@
 #include <assimp/scene.h>
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -91,6 +94,7 @@ struct ImportReport {
   std::string collision_method;         ///< "hull", "decomposition", "sidecar decomposition"
   std::size_t vertices = 0, triangles = 0;
   std::string sidecar;                  ///< path used ("" when none)
+  std::string note;                     ///< why the convex hull stands in for the surface, if it does
   Eigen::Matrix4d file_to_asset{Eigen::Matrix4d::Identity()};  ///< maps file coordinates to the asset frame
   ImportedFunctionalPoints robotwin;
 };
@@ -516,14 +520,35 @@ inline ImportResult import_asset_unchecked(const std::string& mesh_path, const s
     ::manisoft::detail::fail(mesh_path, ": the mesh is flat or degenerate, it encloses no volume (", e.what(), ")");
   }
   report.hull_volume = detail::mesh_volume(hull);
+  // A closed surface is used as the solid only when its integrals describe a real body: volume
+  // within its hull's, inertia positive with l1 + l2 >= l3. Otherwise (self-intersecting or
+  // overlapping shells) the convex hull stands in, and the report says why.
+  geometry::MassProperties<double> mesh_unit;  // density 1
   if (report.closed) {
     report.mesh_volume = volume;
+    std::string problem;
     if (volume > report.hull_volume * (1 + 1e-6)) {
-      // A closed surface cannot hold more than its hull: self-overlapping shells (counted twice).
-      ::manisoft::detail::fail(mesh_path, ": the closed surface's volume ", volume, " m^3 exceeds its convex hull's ",
-                               report.hull_volume, " m^3 (overlapping or self-intersecting shells)");
+      problem = "the closed surface's volume exceeds its convex hull's (overlapping or self-intersecting shells)";
+    } else if (volume < 1e-9 * report.hull_volume) {
+      problem = "the closed surface encloses almost no volume";
+    } else {
+      geometry::ConvexMesh<double> as_mesh;  // mass_properties integrates any closed oriented surface
+      as_mesh.vertices = welded;
+      as_mesh.triangles = solid_tris;
+      as_mesh.source = mesh_path;
+      mesh_unit = geometry::mass_properties(as_mesh, 1.0);
+      const Eigen::Vector3d l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(mesh_unit.inertia).eigenvalues();
+      if (!l.allFinite() || !(l[0] > 0) || l[0] + l[1] < l[2] * (1 - 1e-9)) {
+        problem = "the closed surface's inertia is not that of a real body (self-intersecting surface)";
+      }
     }
-    if (volume < 1e-12 * std::pow(extent.maxCoeff(), 3)) ::manisoft::detail::fail(mesh_path, ": the mesh encloses no volume");
+    if (!problem.empty()) {
+      report.closed = false;
+      report.mesh_volume = 0;
+      report.note = problem + ": the convex hull and its mass properties are used";
+    }
+  } else {
+    report.note = "open surface: the convex hull and its mass properties are used";
   }
 
   // ---- collision
@@ -571,16 +596,8 @@ inline ImportResult import_asset_unchecked(const std::string& mesh_path, const s
   asset.collision = detail::make_collision(pieces);
 
   // ---- mass properties
-  geometry::MassProperties<double> unit;  // density 1
-  if (report.closed) {
-    geometry::ConvexMesh<double> as_mesh;  // mass_properties integrates any closed oriented surface
-    as_mesh.vertices = welded;
-    as_mesh.triangles = solid_tris;
-    as_mesh.source = mesh_path;
-    unit = geometry::mass_properties(as_mesh, 1.0);
-  } else {
-    unit = geometry::mass_properties(asset.collision, 1.0);
-  }
+  const geometry::MassProperties<double> unit =
+      report.closed ? mesh_unit : geometry::mass_properties(asset.collision, 1.0);
   const double density = side.mass ? *side.mass / unit.mass : side.density.value_or(options.default_density);
   const geometry::MassProperties<double> mp = unit.scaled(density);
   if (!(mp.mass > 0) || !std::isfinite(mp.mass) || !mp.inertia.allFinite() || !mp.center_of_mass.allFinite()) {
