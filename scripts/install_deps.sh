@@ -4,6 +4,8 @@ set -euo pipefail
 packages=(cmake make g++ clang libclang-rt-14-dev libeigen3-dev libfcl-dev libccd-dev catch2 libbenchmark-dev)
 # render component: OpenGL through EGL (Mesa llvmpipe), libpng, CLI11; blender and ffmpeg for the Blender adapter and videos
 packages+=(libegl-dev libgl-dev libegl1-mesa-dev libgl1-mesa-dri libegl-mesa0 libpng-dev libcli11-dev blender ffmpeg)
+# import component: users' meshes through assimp, JSON sidecars through nlohmann-json
+packages+=(libassimp-dev nlohmann-json3-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
