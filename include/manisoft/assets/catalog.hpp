@@ -95,7 +95,7 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
   }
   comp.parts.push_back(cp);
   a.collision = comp;
-  const double mass = std::min(r.mass * s * s * s, kind == AssetKind::object ? 0.3 : 1e9);
+  const double mass = std::min(r.mass * s * s * s, kind == AssetKind::object ? 0.29 : 1e9);
   const auto mp = geometry::mass_properties(comp, mass / volume);
   a.mass = mp.mass;
   a.center_of_mass = mp.center_of_mass;
