@@ -3,6 +3,8 @@
 // hand-computed outputs and refuses malformed weight files, and bad targets are refused.
 #include <catch2/catch.hpp>
 
+#include "../support/scratch_dir.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -45,7 +47,7 @@ manisoft::env::ReachInfo run_episode(Env& env, Executor& executor, std::uint64_t
 }
 
 std::string write_file(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / ("manisoft_test_" + name);
+  const auto path = manisoft::test::scratch_dir("manisoft_test_executor") / name;
   std::ofstream(path) << text;
   return path.string();
 }

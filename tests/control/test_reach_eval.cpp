@@ -8,6 +8,7 @@
 #include <string>
 
 #include "../support/command_line.hpp"
+#include "../support/scratch_dir.hpp"
 #include "manisoft/rod/inverse_statics.hpp"
 #include "manisoft/control/mlp_executor.hpp"
 #include "manisoft/env/reach_env.hpp"
@@ -17,7 +18,7 @@ namespace {
 using manisoft::test::read_csv;
 using manisoft::test::slurp;
 
-const std::string scratch = (std::filesystem::temp_directory_path() / "manisoft_reach_eval_test").string();
+const std::string scratch = manisoft::test::scratch_dir("manisoft_reach_eval_test").string();
 
 int run(const std::string& arguments) {
   std::filesystem::create_directories(scratch);

@@ -2,6 +2,8 @@
 // where its centreline projects, determinism, camera validation, EGL failure, PNG round trip.
 #include <catch2/catch.hpp>
 
+#include "../support/scratch_dir.hpp"
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -258,7 +260,7 @@ TEST_CASE("mesh builders: tube radius, box extents, directors or transported fra
 }
 
 TEST_CASE("PNG files round-trip and are written atomically", "[render]") {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "manisoft_test_render_png";
+  const std::filesystem::path dir = manisoft::test::scratch_dir("manisoft_test_render_png");
   std::filesystem::create_directories(dir);
   std::vector<std::uint8_t> rgb(7 * 5 * 3);
   for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = static_cast<std::uint8_t>(i * 37);

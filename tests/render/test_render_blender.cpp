@@ -4,6 +4,8 @@
 // code 77, ctest SKIP_RETURN_CODE) where blender is not installed.
 #include <catch2/catch.hpp>
 
+#include "../support/scratch_dir.hpp"
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -28,7 +30,7 @@ TEST_CASE("Blender Workbench and OpenGL masks agree", "[blender]") {
   frames[1].instance_poses[t.object_instance.at("cube")] = tabletop::at(0.40, 0.10, 0.775);
   frames[1].goal_pose = tabletop::at(0.55, -0.1, 0.95);
 
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "manisoft_test_render_blender";
+  const std::filesystem::path dir = manisoft::test::scratch_dir("manisoft_test_render_blender");
   std::filesystem::remove_all(dir);
   blender::RunOptions options;
   options.engine = "workbench";

@@ -8,6 +8,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "../support/scratch_dir.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -24,7 +26,7 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 std::filesystem::path temp_dir() {
-  auto dir = std::filesystem::temp_directory_path() / "manisoft_rigid_tests";
+  auto dir = manisoft::test::scratch_dir("manisoft_rigid_tests");
   std::filesystem::create_directories(dir);
   return dir;
 }

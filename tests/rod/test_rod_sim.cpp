@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "../support/command_line.hpp"
+#include "../support/scratch_dir.hpp"
 
 namespace {
 
@@ -16,7 +17,7 @@ using manisoft::test::slurp;
 
 int run(const std::string& arguments, const std::string& log) { return manisoft::test::run_command(MANISOFT_ROD_SIM, arguments, log); }
 
-const std::string scratch = (std::filesystem::temp_directory_path() / "manisoft_rod_sim_test").string();
+const std::string scratch = manisoft::test::scratch_dir("manisoft_rod_sim_test").string();
 
 }  // namespace
 
