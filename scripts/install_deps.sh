@@ -6,6 +6,8 @@ packages=(cmake make g++ clang libclang-rt-14-dev libeigen3-dev libfcl-dev libcc
 packages+=(libegl-dev libgl-dev libegl1-mesa-dev libgl1-mesa-dri libegl-mesa0 libpng-dev libcli11-dev blender ffmpeg)
 # import component: users' meshes through assimp, JSON sidecars through nlohmann-json
 packages+=(libassimp-dev nlohmann-json3-dev)
+# dataset component: HDF5 files; h5py and numpy for the Python reader (Debian's /usr/bin/python3)
+packages+=(libhdf5-dev python3-h5py python3-numpy)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
