@@ -1,0 +1,289 @@
+// The language layer (include/manisoft/language/): referring expressions are unique, checked by a
+// matcher written here independently (the set of every truthful phrasing of each object, compared
+// as strings) on hand-built look-alike scenes and on random tables of catalogue assets; instructions
+// fill every placeholder, keep seen and unseen wording apart, are deterministic; the shipped data
+// files are large enough; malformed data files are refused naming the file and the entry.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "../support/scratch_dir.hpp"
+#include "manisoft/assets/catalog.hpp"
+#include "manisoft/language/instructions.hpp"
+
+namespace {
+
+namespace lang = manisoft::language;
+namespace assets = manisoft::assets;
+using Catch::Contains;
+
+const lang::Library& library() {
+  static const lang::Library l = lang::Library::load_default();
+  return l;
+}
+
+/// A hand-made asset: category, main colour and material, size, extra parts (name, colour).
+assets::Asset make(const std::string& category, const std::string& color, const std::string& material,
+                   assets::SizeClass size, std::vector<std::pair<std::string, std::string>> parts = {}) {
+  assets::Asset a;
+  a.id = category + "/hand";
+  a.category = category;
+  a.attributes.color_name = color;
+  a.attributes.material_name = material;
+  a.attributes.size = size;
+  assets::VisualPart body;
+  body.name = "body";
+  body.color_name = color;
+  a.visual.push_back(body);
+  for (const auto& [name, part_color] : parts) {
+    assets::VisualPart p;
+    p.name = name;
+    p.color_name = part_color;
+    a.visual.push_back(p);
+  }
+  return a;
+}
+
+/// Independent matcher: every truthful phrasing of an object ("the [size] [colour] [material]
+/// <noun or its head words> [with the <colour> <part>]"), as strings.
+std::set<std::string> truthful_phrasings(const assets::Asset& a) {
+  std::set<std::string> nouns;
+  const lang::Split split = library().nouns_of(a.category);
+  for (const auto* list : {&split.seen, &split.unseen})
+    for (const std::string& n : *list)
+      for (std::size_t at = 0; at != std::string::npos; at = n.find(' ', at + 1)) nouns.insert(at == 0 ? n : n.substr(at + 1));
+  std::vector<std::string> clauses{""};
+  for (const auto& p : a.visual) clauses.push_back(" with the " + p.color_name + " " + p.name);
+  std::set<std::string> out;
+  const std::string size = assets::to_string(a.attributes.size);
+  for (const auto& noun : nouns)
+    for (int mask = 0; mask < 8; ++mask)
+      for (const auto& clause : clauses) {
+        std::string s = "the ";
+        if (mask & 1) s += size + " ";
+        if (mask & 2) s += a.attributes.color_name + " ";
+        if (mask & 4) s += a.attributes.material_name + " ";
+        out.insert(s + noun + clause);
+      }
+  return out;
+}
+
+int count_matches(const std::string& expression, const std::vector<lang::SceneObject>& scene) {
+  int n = 0;
+  for (const auto& o : scene) n += truthful_phrasings(*o.asset).count(expression) ? 1 : 0;
+  return n;
+}
+
+std::vector<std::string> texts(const std::vector<lang::Description>& ds) {
+  std::vector<std::string> out;
+  for (const auto& d : ds) out.push_back(d.text());
+  return out;
+}
+
+/// A regular expression that matches what a template can produce ({X} -> one or more characters).
+std::regex template_regex(std::string t) {
+  std::string pattern;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] == '{') {
+      i = t.find('}', i);
+      pattern += ".+";
+    } else if (std::string("\\^$.|?*+()[]").find(t[i]) != std::string::npos) {
+      pattern += std::string("\\") + t[i];
+    } else {
+      pattern += t[i];
+    }
+  }
+  return std::regex(pattern);
+}
+
+bool made_from(const std::string& instruction, const std::vector<std::string>& templates) {
+  for (const auto& t : templates) {
+    std::string capitalised = t;
+    if (!capitalised.empty() && capitalised[0] >= 'a' && capitalised[0] <= 'z') capitalised[0] = char(capitalised[0] - 32);
+    if (std::regex_match(instruction, template_regex(capitalised)) ||
+        (t[0] == '{' && std::regex_match(instruction, template_regex(t))))
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("look-alike bottles: only expressions that single one out are produced", "[language]") {
+  using S = assets::SizeClass;
+  const assets::Asset green_cap = make("bottle", "yellow", "plastic", S::medium, {{"cap", "green"}});
+  const assets::Asset red_cap = make("bottle", "yellow", "plastic", S::medium, {{"cap", "red"}});
+  const assets::Asset pills = make("pill_bottle", "white", "plastic", S::small, {{"lid", "white"}});
+  const std::vector<lang::SceneObject> scene{{&green_cap}, {&red_cap}, {&pills}};
+  const auto expressions = texts(lang::referring_expressions(library(), scene, 0));
+  CAPTURE(expressions);
+  for (const char* ambiguous : {"the yellow bottle", "the bottle", "the plastic bottle", "the water bottle",
+                                "the medium yellow bottle", "the yellow plastic bottle"})
+    CHECK(std::find(expressions.begin(), expressions.end(), ambiguous) == expressions.end());
+  CHECK(std::find(expressions.begin(), expressions.end(), "the bottle with the green cap") != expressions.end());
+  for (const auto& e : expressions) CHECK(count_matches(e, scene) == 1);
+  // "bottle" also names the pill bottle ("pill bottle" ends with it): the pill bottle is "the
+  // pill bottle", never "the bottle" (the yellow ones are bottles too).
+  const auto pill_expressions = texts(lang::referring_expressions(library(), scene, 2));
+  CHECK(std::find(pill_expressions.begin(), pill_expressions.end(), "the pill bottle") != pill_expressions.end());
+  CHECK(std::find(pill_expressions.begin(), pill_expressions.end(), "the bottle") == pill_expressions.end());
+  CHECK(std::find(pill_expressions.begin(), pill_expressions.end(), "the white pill bottle") != pill_expressions.end());
+  // Two identical bottles cannot be told apart: no expression, and no instruction.
+  const std::vector<lang::SceneObject> twins{{&green_cap}, {&green_cap}};
+  CHECK(lang::referring_expressions(library(), twins, 0).empty());
+  CHECK_FALSE(lang::make_instructions(library(), twins, {"ALN", {0}, ""}, true, 1).has_value());
+}
+
+TEST_CASE("random tables of catalogue assets: every expression names exactly its object", "[language]") {
+  static const std::vector<assets::Asset> objects = assets::object_catalog();
+  static const std::vector<assets::Asset> obstacles = assets::obstacle_catalog();
+  std::mt19937_64 engine(2026);
+  long checked = 0, described = 0, total = 0;
+  for (int table = 0; table < 100; ++table) {
+    std::vector<lang::SceneObject> scene;
+    const int n_objects = 2 + static_cast<int>(engine() % 6), n_obstacles = static_cast<int>(engine() % 8);
+    for (int i = 0; i < n_objects; ++i) scene.push_back({&objects[engine() % objects.size()]});
+    for (int i = 0; i < n_obstacles; ++i) scene.push_back({&obstacles[engine() % obstacles.size()]});
+    for (int k = 0; k < static_cast<int>(scene.size()); ++k) {
+      ++total;
+      bool any = false;
+      for (const bool seen : {true, false}) {
+        for (const auto& d : lang::referring_expressions(library(), scene, k, seen)) {
+          const std::string e = d.text();
+          INFO("table " << table << " object " << k << " (" << scene[static_cast<std::size_t>(k)].asset->id << "): " << e);
+          REQUIRE(count_matches(e, scene) == 1);
+          REQUIRE(truthful_phrasings(*scene[static_cast<std::size_t>(k)].asset).count(e) == 1);
+          ++checked;
+          any = true;
+        }
+      }
+      described += any ? 1 : 0;
+    }
+  }
+  CHECK(checked > 3000);
+  // Only exact duplicates of an asset on one table (same id drawn twice) can lack an expression.
+  CHECK(described >= total * 9 / 10);
+}
+
+TEST_CASE("instructions: hand-computed canonical sentences for the four tasks", "[language]") {
+  using S = assets::SizeClass;
+  const assets::Asset bottle = make("bottle", "blue", "glass", S::medium);
+  const assets::Asset basket = make("basket", "brown", "wood", S::large);
+  const assets::Asset cup = make("cup", "red", "plastic", S::small);
+  const assets::Asset mug = make("mug", "white", "ceramic", S::medium);
+  const assets::Asset bowl_l = make("bowl", "white", "ceramic", S::large);
+  const assets::Asset bowl_m = make("bowl", "white", "ceramic", S::medium);
+  const assets::Asset bowl_s = make("bowl", "white", "ceramic", S::small);
+  const std::vector<lang::SceneObject> scene{{&bottle}, {&basket}, {&cup}, {&mug}, {&bowl_l}, {&bowl_m}, {&bowl_s}};
+  const auto canonical = [&](const lang::TaskSlots& slots) {
+    const auto made = lang::make_instructions(library(), scene, slots, false, 7);
+    REQUIRE(made.has_value());
+    CHECK(made->seen.empty());
+    CHECK(made->unseen.empty());
+    return made->canonical;
+  };
+  CHECK(canonical({"COLL", {0, 1}, ""}) == "Put the bottle into the basket.");
+  CHECK(canonical({"ALN", {0}, ""}) == "Place the bottle at the marker.");
+  CHECK(canonical({"STK", {4, 5, 6}, ""}) == "Stack the large bowl, the medium bowl and the small bowl, largest at the bottom.");
+  CHECK(canonical({"ARR", {2, 0, 3}, "between"}) == "Place the cup between the bottle and the mug.");
+  CHECK(canonical({"ARR", {2, 0}, "left_of"}) == "Place the cup to the left of the bottle.");
+  CHECK_THROWS_WITH(canonical({"ARR", {2, 0}, "between"}), Contains("ARR between needs 3 objects, got 2"));
+  CHECK_THROWS_WITH(canonical({"COLL", {0, 9}, ""}), Contains("object index 9 is outside the scene's 7 objects"));
+  CHECK_THROWS_WITH(canonical({"SORT", {0}, ""}), Contains("unknown task 'SORT'"));
+}
+
+TEST_CASE("randomized instructions: about 40, distinct, filled, seen and unseen wording apart, deterministic", "[language]") {
+  using S = assets::SizeClass;
+  const assets::Asset bottle = make("bottle", "blue", "glass", S::medium, {{"cap", "black"}});
+  const assets::Asset other_bottle = make("bottle", "green", "plastic", S::large);
+  const assets::Asset basket = make("basket", "brown", "wood", S::large);
+  const assets::Asset cup = make("cup", "red", "plastic", S::small);
+  const assets::Asset mug = make("mug", "white", "ceramic", S::medium);
+  const std::vector<lang::SceneObject> scene{{&bottle}, {&other_bottle}, {&basket}, {&cup}, {&mug}};
+  for (const lang::TaskSlots& slots : {lang::TaskSlots{"COLL", {0, 2}, ""}, lang::TaskSlots{"ALN", {0}, ""},
+                                       lang::TaskSlots{"STK", {2, 4, 3}, ""}, lang::TaskSlots{"ARR", {0, 3, 4}, "in_a_row"},
+                                       lang::TaskSlots{"ARR", {3, 0}, "behind"}}) {
+    CAPTURE(slots.task, slots.relation);
+    const auto made = lang::make_instructions(library(), scene, slots, true, 42);
+    REQUIRE(made.has_value());
+    CHECK(made->seen.size() == 32);
+    CHECK(made->unseen.size() == 8);
+    std::set<std::string> all(made->seen.begin(), made->seen.end());
+    for (const auto& u : made->unseen) CHECK(all.insert(u).second);  // distinct, and disjoint
+    const auto& templates = library().templates.at(slots.task);
+    for (const auto& s : made->seen) {
+      CHECK(s.find('{') == std::string::npos);
+      CHECK(made_from(s, templates.seen));
+      // Never "the bottle" (or "the water bottle") alone: two bottles are on the table.
+      CHECK_FALSE(std::regex_search(s, std::regex("the (water |drink )?bottle(?! with)[ .,?]")));
+    }
+    for (const auto& u : made->unseen) {
+      CHECK(u.find('{') == std::string::npos);
+      CHECK(made_from(u, templates.unseen));
+    }
+    const auto again = lang::make_instructions(library(), scene, slots, true, 42);
+    CHECK(again->seen == made->seen);
+    CHECK(again->unseen == made->unseen);
+    CHECK(lang::make_instructions(library(), scene, slots, true, 43)->seen != made->seen);
+  }
+}
+
+TEST_CASE("the shipped data: >= 30 templates per task, nouns for every catalogue category", "[language]") {
+  for (const char* task : {"COLL", "ALN", "STK", "ARR"}) {
+    const auto& t = library().templates.at(task);
+    CAPTURE(task);
+    CHECK(t.seen.size() + t.unseen.size() >= 30);
+    CHECK(t.seen.size() >= 3 * t.unseen.size());  // about 4:1
+  }
+  std::set<std::string> categories;
+  for (const auto& a : assets::object_catalog()) categories.insert(a.category);
+  for (const auto& a : assets::obstacle_catalog()) categories.insert(a.category);
+  for (const auto& c : categories) {
+    CAPTURE(c);
+    CHECK(library().nouns.count(c) == 1);
+  }
+}
+
+TEST_CASE("malformed language files are refused naming the file and the entry", "[language][input]") {
+  const auto dir = manisoft::test::scratch_dir("manisoft_language_files");
+  const std::string good_objects = R"({"categories": {"bottle": {"seen": ["bottle"], "unseen": []}}})";
+  const auto tasks_with = [](const std::string& coll, const std::string& aln) {
+    const std::string rel = R"("relations": {"left_of": {"seen": ["left of {B}"], "unseen": ["just left of {B}"]},
+      "right_of": {"seen": ["right of {B}"], "unseen": ["x {B}"]}, "in_front_of": {"seen": ["a {B}"], "unseen": ["b {B}"]},
+      "behind": {"seen": ["c {B}"], "unseen": ["d {B}"]}, "next_to": {"seen": ["e {B}"], "unseen": ["f {B}"]},
+      "between": {"seen": ["g {B} {C}"], "unseen": ["h {B} {C}"]}, "in_a_row": {"seen": ["i {B} {C}"], "unseen": ["j {B} {C}"]}})";
+    return "{\"COLL\": " + coll + ", \"ALN\": " + aln +
+           R"(, "STK": {"seen": ["Stack {ITEMS}."], "unseen": ["Pile {ITEMS}."]},
+               "ARR": {"seen": ["Put {A} {RELATION}."], "unseen": ["Move {A} {RELATION}."]}, )" + rel + "}";
+  };
+  const std::string coll = R"({"seen": ["Put {A} in {B}."], "unseen": ["Drop {A} in {B}."]})";
+  const std::string aln = R"({"seen": ["Align {A}."], "unseen": ["Match {A}."]})";
+  const auto load_with = [&](const std::string& tasks, const std::string& objects) {
+    std::ofstream(dir / "tasks.json") << tasks;
+    std::ofstream(dir / "objects.json") << objects;
+    return lang::Library::load(dir);
+  };
+  CHECK_NOTHROW(load_with(tasks_with(coll, aln), good_objects));
+  CHECK_THROWS_WITH(load_with(tasks_with(coll, aln) + "}", good_objects), Contains("tasks.json: malformed JSON at byte"));
+  CHECK_THROWS_WITH(load_with(tasks_with(coll, R"({"seen": ["Align {A} with {B}."], "unseen": ["x {A}"]})"), good_objects),
+                    Contains("tasks.json: entry 'ALN'.seen[0] 'Align {A} with {B}.' uses {B}, which ALN does not fill"));
+  CHECK_THROWS_WITH(load_with(tasks_with(coll, R"({"seen": ["Align {A."], "unseen": ["x {A}"]})"), good_objects),
+                    Contains("entry 'ALN'.seen[0] 'Align {A.': '{' without '}'"));
+  CHECK_THROWS_WITH(load_with(tasks_with(coll, R"({"seen": ["Align {A}."], "unseen": ["Align {A}."]})"), good_objects),
+                    Contains("entry 'ALN': 'Align {A}.' is both seen and unseen"));
+  CHECK_THROWS_WITH(load_with(tasks_with(coll, R"({"seen": ["Align {A}."]})"), good_objects),
+                    Contains("entry 'ALN' must be an object with 'seen' and 'unseen' lists"));
+  CHECK_THROWS_WITH(load_with(tasks_with(coll, R"({"seen": [3], "unseen": ["x {A}"]})"), good_objects),
+                    Contains("entry 'ALN'.seen[0] must be a non-empty string"));
+  CHECK_THROWS_WITH(load_with(tasks_with(coll, aln), R"({"categories": {"bottle": {"seen": ["{A} bottle"], "unseen": []}}})"),
+                    Contains("objects.json: entry 'categories.bottle'.seen[0] '{A} bottle' uses {A}"));
+  CHECK_THROWS_WITH(load_with(tasks_with(coll, aln), R"({"nouns": {}})"), Contains("objects.json: entry 'categories' must be"));
+  std::filesystem::remove(dir / "tasks.json");
+  CHECK_THROWS_WITH(lang::Library::load(dir), Contains("tasks.json: cannot open the language file"));
+}
