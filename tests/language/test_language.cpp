@@ -52,14 +52,16 @@ assets::Asset make(const std::string& category, const std::string& color, const 
 
 /// Independent matcher: every truthful phrasing of an object ("the [size] [colour] [material]
 /// <noun or its head words> [with the <colour> <part>]"), as strings.
-std::set<std::string> truthful_phrasings(const assets::Asset& a) {
+std::set<std::string> truthful_phrasings(const assets::Asset& a, const std::string& scene_color = "") {
+  const std::string color = scene_color.empty() ? a.attributes.color_name : scene_color;
   std::set<std::string> nouns;
   const lang::Split split = library().nouns_of(a.category);
   for (const auto* list : {&split.seen, &split.unseen})
     for (const std::string& n : *list)
       for (std::size_t at = 0; at != std::string::npos; at = n.find(' ', at + 1)) nouns.insert(at == 0 ? n : n.substr(at + 1));
   std::vector<std::string> clauses{""};
-  for (const auto& p : a.visual) clauses.push_back(" with the " + p.color_name + " " + p.name);
+  for (std::size_t k = 0; k < a.visual.size(); ++k)
+    clauses.push_back(" with the " + (k == 0 ? color : a.visual[k].color_name) + " " + a.visual[k].name);
   std::set<std::string> out;
   const std::string size = assets::to_string(a.attributes.size);
   for (const auto& noun : nouns)
@@ -67,16 +69,23 @@ std::set<std::string> truthful_phrasings(const assets::Asset& a) {
       for (const auto& clause : clauses) {
         std::string s = "the ";
         if (mask & 1) s += size + " ";
-        if (mask & 2) s += a.attributes.color_name + " ";
+        if (mask & 2) s += color + " ";
         if (mask & 4) s += a.attributes.material_name + " ";
         out.insert(s + noun + clause);
       }
   return out;
 }
 
+lang::SceneObject on(const assets::Asset& asset, const std::string& color = "") {
+  lang::SceneObject o;
+  o.asset = &asset;
+  o.color_name = color;
+  return o;
+}
+
 int count_matches(const std::string& expression, const std::vector<lang::SceneObject>& scene) {
   int n = 0;
-  for (const auto& o : scene) n += truthful_phrasings(*o.asset).count(expression) ? 1 : 0;
+  for (const auto& o : scene) n += truthful_phrasings(*o.asset, o.color_name).count(expression) ? 1 : 0;
   return n;
 }
 
@@ -120,7 +129,7 @@ TEST_CASE("look-alike bottles: only expressions that single one out are produced
   const assets::Asset green_cap = make("bottle", "yellow", "plastic", S::medium, {{"cap", "green"}});
   const assets::Asset red_cap = make("bottle", "yellow", "plastic", S::medium, {{"cap", "red"}});
   const assets::Asset pills = make("pill_bottle", "white", "plastic", S::small, {{"lid", "white"}});
-  const std::vector<lang::SceneObject> scene{{&green_cap}, {&red_cap}, {&pills}};
+  const std::vector<lang::SceneObject> scene{on(green_cap), on(red_cap), on(pills)};
   const auto expressions = texts(lang::referring_expressions(library(), scene, 0));
   CAPTURE(expressions);
   for (const char* ambiguous : {"the yellow bottle", "the bottle", "the plastic bottle", "the water bottle",
@@ -134,8 +143,15 @@ TEST_CASE("look-alike bottles: only expressions that single one out are produced
   CHECK(std::find(pill_expressions.begin(), pill_expressions.end(), "the pill bottle") != pill_expressions.end());
   CHECK(std::find(pill_expressions.begin(), pill_expressions.end(), "the bottle") == pill_expressions.end());
   CHECK(std::find(pill_expressions.begin(), pill_expressions.end(), "the white pill bottle") != pill_expressions.end());
+  // A scene that recolours the second bottle red makes "the yellow bottle" unique, and "the red
+  // bottle" names the recoloured one.
+  std::vector<lang::SceneObject> recoloured{on(green_cap), on(red_cap, "red"), on(pills)};
+  const auto yellow = texts(lang::referring_expressions(library(), recoloured, 0));
+  CHECK(std::find(yellow.begin(), yellow.end(), "the yellow bottle") != yellow.end());
+  const auto red = texts(lang::referring_expressions(library(), recoloured, 1));
+  CHECK(std::find(red.begin(), red.end(), "the red bottle") != red.end());
   // Two identical bottles cannot be told apart: no expression, and no instruction.
-  const std::vector<lang::SceneObject> twins{{&green_cap}, {&green_cap}};
+  const std::vector<lang::SceneObject> twins{on(green_cap), on(green_cap)};
   CHECK(lang::referring_expressions(library(), twins, 0).empty());
   CHECK_FALSE(lang::make_instructions(library(), twins, {"ALN", {0}, ""}, true, 1).has_value());
 }
@@ -148,8 +164,13 @@ TEST_CASE("random tables of catalogue assets: every expression names exactly its
   for (int table = 0; table < 100; ++table) {
     std::vector<lang::SceneObject> scene;
     const int n_objects = 2 + static_cast<int>(engine() % 6), n_obstacles = static_cast<int>(engine() % 8);
-    for (int i = 0; i < n_objects; ++i) scene.push_back({&objects[engine() % objects.size()]});
-    for (int i = 0; i < n_obstacles; ++i) scene.push_back({&obstacles[engine() % obstacles.size()]});
+    for (int i = 0; i < n_objects; ++i) {
+      // A quarter of the objects recoloured by the scene, as randomized scenes do.
+      static const std::vector<std::string> colors{"red", "blue", "green", "yellow", "white"};
+      const auto& asset = objects[engine() % objects.size()];
+      scene.push_back(on(asset, engine() % 4 == 0 ? colors[engine() % colors.size()] : ""));
+    };
+    for (int i = 0; i < n_obstacles; ++i) scene.push_back(on(obstacles[engine() % obstacles.size()]));
     for (int k = 0; k < static_cast<int>(scene.size()); ++k) {
       ++total;
       bool any = false;
@@ -158,7 +179,7 @@ TEST_CASE("random tables of catalogue assets: every expression names exactly its
           const std::string e = d.text();
           INFO("table " << table << " object " << k << " (" << scene[static_cast<std::size_t>(k)].asset->id << "): " << e);
           REQUIRE(count_matches(e, scene) == 1);
-          REQUIRE(truthful_phrasings(*scene[static_cast<std::size_t>(k)].asset).count(e) == 1);
+          REQUIRE(truthful_phrasings(*scene[static_cast<std::size_t>(k)].asset, scene[static_cast<std::size_t>(k)].color_name).count(e) == 1);
           ++checked;
           any = true;
         }
@@ -180,7 +201,7 @@ TEST_CASE("instructions: hand-computed canonical sentences for the four tasks", 
   const assets::Asset bowl_l = make("bowl", "white", "ceramic", S::large);
   const assets::Asset bowl_m = make("bowl", "white", "ceramic", S::medium);
   const assets::Asset bowl_s = make("bowl", "white", "ceramic", S::small);
-  const std::vector<lang::SceneObject> scene{{&bottle}, {&basket}, {&cup}, {&mug}, {&bowl_l}, {&bowl_m}, {&bowl_s}};
+  const std::vector<lang::SceneObject> scene{on(bottle), on(basket), on(cup), on(mug), on(bowl_l), on(bowl_m), on(bowl_s)};
   const auto canonical = [&](const lang::TaskSlots& slots) {
     const auto made = lang::make_instructions(library(), scene, slots, false, 7);
     REQUIRE(made.has_value());
@@ -205,7 +226,7 @@ TEST_CASE("randomized instructions: about 40, distinct, filled, seen and unseen 
   const assets::Asset basket = make("basket", "brown", "wood", S::large);
   const assets::Asset cup = make("cup", "red", "plastic", S::small);
   const assets::Asset mug = make("mug", "white", "ceramic", S::medium);
-  const std::vector<lang::SceneObject> scene{{&bottle}, {&other_bottle}, {&basket}, {&cup}, {&mug}};
+  const std::vector<lang::SceneObject> scene{on(bottle), on(other_bottle), on(basket), on(cup), on(mug)};
   for (const lang::TaskSlots& slots : {lang::TaskSlots{"COLL", {0, 2}, ""}, lang::TaskSlots{"ALN", {0}, ""},
                                        lang::TaskSlots{"STK", {2, 4, 3}, ""}, lang::TaskSlots{"ARR", {0, 3, 4}, "in_a_row"},
                                        lang::TaskSlots{"ARR", {3, 0}, "behind"}}) {

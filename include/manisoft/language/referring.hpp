@@ -3,6 +3,7 @@
 // (assets::Attributes and the visual parts' colours; the ManiSoft benchmark paper, section 3.5,
 // asks for attribute-aware descriptions in randomized scenes).
 //
+// A scene may recolour an object (SceneObject::color_name): the expressions use the scene's colour.
 // Every expression produced identifies its object uniquely among ALL objects and obstacles on
 // the table: an expression is kept only if no other object could be meant by it under any reading
 // of its words (could_refer_to). A noun names an object when one of the object's category nouns (seen or
@@ -29,6 +30,9 @@ namespace manisoft::language {
 struct SceneObject {
   const assets::Asset* asset = nullptr;
   Eigen::Vector3d position{Eigen::Vector3d::Zero()};  ///< world, m
+  std::string color_name;  ///< the scene's colour of the main part; empty: the asset's own
+
+  const std::string& main_color() const { return color_name.empty() ? asset->attributes.color_name : color_name; }
 };
 
 /// What an expression says about its object.
@@ -61,11 +65,12 @@ inline bool noun_names(const Library& library, const std::string& noun, const st
 
 /// The parts that can tell an object apart: named visual parts after the first (the body) whose
 /// colour differs from the main colour, as (part name, colour).
-inline std::vector<std::pair<std::string, std::string>> distinctive_parts(const assets::Asset& asset) {
+inline std::vector<std::pair<std::string, std::string>> distinctive_parts(const SceneObject& object) {
+  const assets::Asset& asset = *object.asset;
   std::vector<std::pair<std::string, std::string>> parts;
   for (std::size_t k = 1; k < asset.visual.size(); ++k) {
     const auto& p = asset.visual[k];
-    if (!p.name.empty() && !p.color_name.empty() && p.color_name != asset.attributes.color_name)
+    if (!p.name.empty() && !p.color_name.empty() && p.color_name != object.main_color())
       parts.emplace_back(p.name, p.color_name);
   }
   return parts;
@@ -75,7 +80,8 @@ inline std::vector<std::pair<std::string, std::string>> distinctive_parts(const 
 /// of reading it counts: the words before the noun are any of the asset's size, colour and
 /// material (in that order, each optional) and the rest a noun of its category (or its head
 /// words), so "the glass jar" also refers to a glass candle jar ("candle jar" ends with "jar").
-inline bool could_refer_to(const Library& library, const std::string& text, const assets::Asset& asset) {
+inline bool could_refer_to(const Library& library, const std::string& text, const SceneObject& object) {
+  const assets::Asset& asset = *object.asset;
   if (!text.starts_with("the ")) return false;
   std::string rest = text.substr(4);
   const std::size_t with = rest.find(" with the ");
@@ -83,7 +89,10 @@ inline bool could_refer_to(const Library& library, const std::string& text, cons
     const std::string clause = rest.substr(with + 10);
     rest = rest.substr(0, with);
     bool found = false;
-    for (const auto& p : asset.visual) found = found || clause == p.color_name + " " + p.name;
+    for (std::size_t k = 0; k < asset.visual.size(); ++k) {
+      const auto& p = asset.visual[k];
+      found = found || clause == (k == 0 ? object.main_color() : p.color_name) + " " + p.name;
+    }
     if (!found) return false;
   }
   const auto& a = asset.attributes;
@@ -96,7 +105,7 @@ inline bool could_refer_to(const Library& library, const std::string& text, cons
       std::string said;
       const auto append = [&said](const std::string& w) { said += said.empty() ? w : " " + w; };
       if (mask & 1) append(size);
-      if (mask & 2) append(a.color_name);
+      if (mask & 2) append(object.main_color());
       if (mask & 4) append(a.material_name);
       if (said == words) return true;
     }
@@ -112,10 +121,11 @@ inline std::vector<Description> referring_expressions(const Library& library, st
     ::manisoft::detail::fail("referring_expressions: target ", target, " is outside the ", objects.size(), " objects");
   for (std::size_t i = 0; i < objects.size(); ++i)
     if (objects[i].asset == nullptr) ::manisoft::detail::fail("referring_expressions: object ", i, " has no asset");
-  const assets::Asset& asset = *objects[static_cast<std::size_t>(target)].asset;
+  const SceneObject& object = objects[static_cast<std::size_t>(target)];
+  const assets::Asset& asset = *object.asset;
   const auto& a = asset.attributes;
   const std::string size = assets::to_string(a.size);
-  const auto parts = distinctive_parts(asset);
+  const auto parts = distinctive_parts(object);
   const Split nouns = library.nouns_of(asset.category);
   const auto& noun_list = nouns.of(seen_nouns).empty() ? nouns.seen : nouns.of(seen_nouns);
 
@@ -124,7 +134,7 @@ inline std::vector<Description> referring_expressions(const Library& library, st
                             const std::string& material, const std::string& part = "", const std::string& part_color = "") {
     forms.push_back(Description{noun, color, size_word, material, part, part_color});
   };
-  const std::string& color = a.color_name;
+  const std::string& color = object.main_color();
   const std::string& material = a.material_name;
   for (const std::string& noun : noun_list) {
     add(noun, "", "", "");
@@ -148,7 +158,7 @@ inline std::vector<Description> referring_expressions(const Library& library, st
   for (const Description& d : forms) {
     bool ambiguous = false;
     for (std::size_t j = 0; j < objects.size() && !ambiguous; ++j)
-      ambiguous = static_cast<int>(j) != target && could_refer_to(library, d.text(), *objects[j].asset);
+      ambiguous = static_cast<int>(j) != target && could_refer_to(library, d.text(), objects[j]);
     if (!ambiguous) unique.push_back(d);
   }
   return unique;
