@@ -1,9 +1,21 @@
 // The procedurally generated asset catalogue of the "ManiSoft" benchmark (paper section 3.3,
 // assets): graspable objects (object_catalog) and obstacles (obstacle_catalog). Every instance is
 // built deterministically from its category's parameters and instance index (no randomness): a
-// lathe (surface of revolution, collision = equal-volume cylinder) or a box. Masses come from
-// geometry::mass_properties with an effective density chosen so the mass is realistic for the
-// (possibly hollow) real object.
+// lathe (surface of revolution, collision = equal-volume cylinder) or a box. Containers and
+// tableware (cup, pen cup, plate, bowl, mug, basket) are hollow: the visual lathe runs up the
+// outside, over the rim and down the inside to the floor (an open box for the basket), and the
+// collision model is a compound of a floor and a ring of wall planks (24 per profile band, each
+// as wide as the ring's circumference at its mid-height / 24, so the compound's volume matches the
+// visual shell's), so things dropped in stay in. Masses come from geometry::mass_properties with
+// an effective density chosen so the mass is realistic for the real object.
+//
+// Grasps (one per object, tool-down, closing along the asset's x axis) are made for the ManiSoft
+// parallel gripper (GraspGripper restates interaction::ParallelGripperParameters' defaults: this
+// layer sits above interaction; tests/assets/test_asset_grasps.cpp checks that they agree): the
+// palm stops palm_clearance above the object's top, but never so low that the fingertips come
+// closer than table_clearance to the support plane (flat objects: plate, bowl, basket, Rubik's
+// cube); the annotated width is the object's extent along the closing axis over the fingers'
+// height range.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +32,15 @@
 #include "manisoft/render/mesh_builders.hpp"
 
 namespace manisoft::assets {
+
+/// The gripper the grasp annotations are made for (see the header comment).
+struct GraspGripper {
+  double palm_thickness = 0.05;    ///< m, attachment frame to the fingers' root
+  double finger_length = 0.07;     ///< m
+  double open_width = 0.10;        ///< m, between the inner finger faces
+  double palm_clearance = 0.005;   ///< m, palm above the object's top
+  double table_clearance = 0.01;   ///< m, fingertips above the support plane
+};
 
 namespace catalog_detail {
 
@@ -49,6 +70,133 @@ struct Recipe {
   bool on_side = false;
 };
 
+/// Radius of a profile at height z (linear between points; clamped to the ends).
+inline double profile_radius(const std::vector<ProfilePoint>& p, double z) {
+  if (z <= p.front().z) return p.front().radius;
+  for (std::size_t k = 0; k + 1 < p.size(); ++k) {
+    if (z <= p[k + 1].z) {
+      const double dz = p[k + 1].z - p[k].z;
+      const double t = dz > 0 ? (z - p[k].z) / dz : 1.0;
+      return p[k].radius + t * (p[k + 1].radius - p[k].radius);
+    }
+  }
+  return p.back().radius;
+}
+
+/// Largest radius of a profile over heights [z0, z1] (at its points inside, or at the ends).
+inline double max_profile_radius(const std::vector<ProfilePoint>& p, double z0, double z1) {
+  double r = std::max(profile_radius(p, z0), profile_radius(p, z1));
+  for (const auto& q : p)
+    if (q.z >= z0 && q.z <= z1) r = std::max(r, q.radius);
+  return r;
+}
+
+/// The closed cross-section of a hollow lathe of wall thickness t: up the outer profile, over the
+/// rim, down the inner wall (the outer radius less t at each height) to the floor at z = t.
+inline std::vector<ProfilePoint> hollow_profile(const std::vector<ProfilePoint>& outer, double t) {
+  std::vector<ProfilePoint> out = outer;
+  for (std::size_t k = outer.size(); k-- > 0;) {
+    if (outer[k].z <= t) break;
+    out.push_back({outer[k].radius - t, outer[k].z});
+  }
+  out.push_back({profile_radius(outer, t) - t, t});
+  return out;
+}
+
+/// Collision compound of a hollow lathe: a floor disc (z in [0, t]) and per outer profile band
+/// above the floor a ring of `planks` boxes, each spanning the band's slant between the outer
+/// surface and the inner one (horizontal thickness t) and as wide as the ring's circumference at
+/// the band's mid-height divided by the plank count.
+inline geometry::Compound<double> hollow_lathe_collision(const std::vector<ProfilePoint>& outer, double t, int planks = 24) {
+  const double pi = 3.14159265358979323846;
+  geometry::Compound<double> c;
+  geometry::CompoundPart<double> floor;
+  floor.shape = geometry::Cylinder<double>{profile_radius(outer, 0.5 * t), 0.5 * t};
+  floor.position = Eigen::Vector3d(0, 0, 0.5 * t);
+  c.parts.push_back(floor);
+  for (std::size_t k = 0; k + 1 < outer.size(); ++k) {
+    const double za = std::max(outer[k].z, t), zb = outer[k + 1].z;
+    if (!(zb > za + 1e-9)) continue;
+    const double ra = profile_radius(outer, za) - 0.5 * t, rb = outer[k + 1].radius - 0.5 * t;  // wall centre line
+    const double length = std::hypot(rb - ra, zb - za);
+    const double alpha = std::atan2(rb - ra, zb - za);  // from the vertical, outward positive
+    const double r_mid = 0.5 * (ra + rb);
+    const double half_width = r_mid * std::tan(pi / planks);
+    for (int i = 0; i < planks; ++i) {
+      const double phi = 2.0 * pi * i / planks;
+      const Eigen::Vector3d er(std::cos(phi), std::sin(phi), 0.0), et(-std::sin(phi), std::cos(phi), 0.0), ez = Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d slant = std::sin(alpha) * er + std::cos(alpha) * ez;
+      const Eigen::Vector3d outward = std::cos(alpha) * er - std::sin(alpha) * ez;
+      geometry::CompoundPart<double> plank;
+      plank.shape = geometry::Box<double>{Eigen::Vector3d(half_width, 0.5 * t * std::cos(alpha), 0.5 * length)};
+      plank.position = r_mid * er + 0.5 * (za + zb) * ez;
+      Eigen::Matrix3d r;
+      r.col(0) = et;
+      r.col(1) = -outward;
+      r.col(2) = slant;
+      plank.orientation = Eigen::Quaterniond(r);
+      c.parts.push_back(plank);
+    }
+  }
+  return c;
+}
+
+/// Closed, outward-wound mesh of an open-topped box (outer half sizes hx, hy, height h, walls and
+/// floor of thickness t), origin at the centre of its bottom face, flat normals, planar UVs.
+inline render::Mesh open_box_mesh(double hx, double hy, double h, double t) {
+  render::Mesh m;
+  auto quad = [&m](const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c, const Eigen::Vector3f& d,
+                   const Eigen::Vector3f& n) {
+    const auto base = static_cast<std::uint32_t>(m.positions.size());
+    for (const Eigen::Vector3f* p : {&a, &b, &c, &d}) {
+      m.positions.push_back(*p);
+      m.normals.push_back(n);
+      // planar UVs on the face's two tangent axes
+      const int ax = std::abs(n.x()) > 0.5f ? 1 : 0, ay = std::abs(n.z()) > 0.5f ? 1 : 2;
+      m.uvs.emplace_back((*p)[ax] * 5.0f, (*p)[ay] * 5.0f);
+    }
+    const bool ccw = ((b - a).cross(c - a)).dot(n) > 0;
+    if (ccw) m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    else m.indices.insert(m.indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+  };
+  const float X = static_cast<float>(hx), Y = static_cast<float>(hy), H = static_cast<float>(h), T = static_cast<float>(t);
+  const float x = static_cast<float>(hx - t), y = static_cast<float>(hy - t);
+  using V = Eigen::Vector3f;
+  quad(V(-X, -Y, 0), V(X, -Y, 0), V(X, Y, 0), V(-X, Y, 0), V(0, 0, -1));                   // bottom
+  quad(V(X, -Y, 0), V(X, Y, 0), V(X, Y, H), V(X, -Y, H), V(1, 0, 0));                       // outer sides
+  quad(V(-X, -Y, 0), V(-X, Y, 0), V(-X, Y, H), V(-X, -Y, H), V(-1, 0, 0));
+  quad(V(-X, Y, 0), V(X, Y, 0), V(X, Y, H), V(-X, Y, H), V(0, 1, 0));
+  quad(V(-X, -Y, 0), V(X, -Y, 0), V(X, -Y, H), V(-X, -Y, H), V(0, -1, 0));
+  quad(V(X, -Y, H), V(X, Y, H), V(x, y, H), V(x, -y, H), V(0, 0, 1));                       // rim
+  quad(V(-X, -Y, H), V(-X, Y, H), V(-x, y, H), V(-x, -y, H), V(0, 0, 1));
+  quad(V(-X, Y, H), V(X, Y, H), V(x, y, H), V(-x, y, H), V(0, 0, 1));
+  quad(V(-X, -Y, H), V(X, -Y, H), V(x, -y, H), V(-x, -y, H), V(0, 0, 1));
+  quad(V(x, -y, T), V(x, y, T), V(x, y, H), V(x, -y, H), V(-1, 0, 0));                      // inner walls
+  quad(V(-x, -y, T), V(-x, y, T), V(-x, y, H), V(-x, -y, H), V(1, 0, 0));
+  quad(V(-x, y, T), V(x, y, T), V(x, y, H), V(-x, y, H), V(0, -1, 0));
+  quad(V(-x, -y, T), V(x, -y, T), V(x, -y, H), V(-x, -y, H), V(0, 1, 0));
+  quad(V(-x, -y, T), V(x, -y, T), V(x, y, T), V(-x, y, T), V(0, 0, 1));                     // inner floor
+  return m;
+}
+
+/// Collision compound of the open box: floor plus four walls, touching but not overlapping.
+inline geometry::Compound<double> open_box_collision(double hx, double hy, double h, double t) {
+  geometry::Compound<double> c;
+  auto add = [&c](Eigen::Vector3d half, Eigen::Vector3d at) {
+    geometry::CompoundPart<double> p;
+    p.shape = geometry::Box<double>{half};
+    p.position = at;
+    c.parts.push_back(p);
+  };
+  const double wall_half_z = 0.5 * (h - t), wall_z = t + wall_half_z;
+  add({hx, hy, 0.5 * t}, {0, 0, 0.5 * t});
+  for (double s : {-1.0, 1.0}) {
+    add({0.5 * t, hy, wall_half_z}, {s * (hx - 0.5 * t), 0, wall_z});
+    add({hx - t, 0.5 * t, wall_half_z}, {0, s * (hy - 0.5 * t), wall_z});
+  }
+  return c;
+}
+
 inline std::string two_digits(int i) {
   char buf[8];
   std::snprintf(buf, sizeof buf, "%02d", i);
@@ -76,27 +224,35 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
   part.material.base_color = Eigen::Vector3f(col.r, col.g, col.b);
   part.color_name = col.name;
   part.material_name = r.material;
-  double volume = 0;
   geometry::Compound<double> comp;
   geometry::CompoundPart<double> cp;
+  const double wall = 0.004;                 // containers: wall and floor thickness, m
+  std::vector<ProfilePoint> prof;            // lathe: the scaled outer profile
   if (r.lathe) {
-    std::vector<ProfilePoint> prof;
     for (const auto& p : r.profile) prof.push_back({p.radius * 0.5 * size.x(), p.z * size.z()});
-    part.mesh = make_lathe_mesh(prof, 32);
-    volume = lathe_volume(prof, 32);
-    cp.shape = lathe_equal_volume_cylinder(prof, 32);
-    cp.position = Eigen::Vector3d(0, 0, 0.5 * size.z());
+    if (r.receptacle) {
+      const auto section = hollow_profile(prof, wall);
+      part.mesh = make_lathe_mesh(section, 32);
+      comp = hollow_lathe_collision(prof, wall);
+    } else {
+      part.mesh = make_lathe_mesh(prof, 32);
+      cp.shape = lathe_equal_volume_cylinder(prof, 32);
+      cp.position = Eigen::Vector3d(0, 0, 0.5 * size.z());
+      comp.parts.push_back(cp);
+    }
+  } else if (r.receptacle) {
+    part.mesh = open_box_mesh(0.5 * size.x(), 0.5 * size.y(), size.z(), wall);
+    comp = open_box_collision(0.5 * size.x(), 0.5 * size.y(), size.z(), wall);
   } else {
     part.mesh = render::make_box(0.5 * size);
     for (auto& p : part.mesh.positions) p.z() += static_cast<float>(0.5 * size.z());
-    volume = size.prod();
     cp.shape = geometry::Box<double>{0.5 * size};
     cp.position = Eigen::Vector3d(0, 0, 0.5 * size.z());
+    comp.parts.push_back(cp);
   }
-  comp.parts.push_back(cp);
   a.collision = comp;
   const double mass = std::min(r.mass * s * s * s, kind == AssetKind::object ? 0.29 : 1e9);
-  const auto mp = geometry::mass_properties(comp, mass / volume);
+  const auto mp = geometry::mass_properties(comp, mass / geometry::shape_volume(geometry::Shape<double>(comp)));
   a.mass = mp.mass;
   a.center_of_mass = mp.center_of_mass;
   a.inertia = mp.inertia;
@@ -115,27 +271,40 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
                                           0.5 * size.x(), "on its side"});
   }
   if (kind == AssetKind::object) {
+    const GraspGripper gg;
     GraspAnnotation g;
     math::Matrix3<double> R;
-    R << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+    R << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // x closing along the asset's x, z (approach) straight down
     const double top = size.z();
+    const double frame_z = std::max(top + gg.palm_clearance + gg.palm_thickness,
+                                    gg.table_clearance + gg.palm_thickness + gg.finger_length);
     g.grasp.rotation = R;
-    g.grasp.translation = Eigen::Vector3d(0, 0, top + 0.05);
+    g.grasp.translation = Eigen::Vector3d(0, 0, frame_z);
     g.approach = g.grasp;
     g.approach.translation.z() += 0.10;
     g.lift = g.grasp;
     g.lift.translation.z() += 0.15;
-    g.width = size.x();
+    // Extent along the closing axis over the fingers' height range [tips, palm] within the object.
+    const double lo = std::max(0.0, frame_z - gg.palm_thickness - gg.finger_length);
+    const double hi = std::min(top, frame_z - gg.palm_thickness);
+    g.width = r.lathe ? 2.0 * max_profile_radius(prof, lo, hi) : size.x();
     a.grasps.push_back(g);
   }
   if (r.receptacle) {
+    // The inner volume: the vertical cylinder (box) that fits the cavity from the floor (z = wall)
+    // to the rim: for a lathe the smallest inner radius over that height.
     Receptacle rc;
     rc.opening.translation = Eigen::Vector3d(0, 0, size.z());
-    const double wall = 0.004;
-    if (r.lathe) rc.inner_radius = 0.5 * size.x() * r.profile.back().radius - wall;
-    else rc.inner_half_extents = Eigen::Vector2d(0.5 * size.x() - wall, 0.5 * size.y() - wall);
-    rc.inner_depth = std::max(0.0, size.z() - wall);
-    rc.placement.translation = Eigen::Vector3d(0, 0, size.z() - rc.inner_depth);
+    if (r.lathe) {
+      double rmin = profile_radius(prof, wall);
+      for (const auto& p : prof)
+        if (p.z >= wall) rmin = std::min(rmin, p.radius);
+      rc.inner_radius = rmin - wall;
+    } else {
+      rc.inner_half_extents = Eigen::Vector2d(0.5 * size.x() - wall, 0.5 * size.y() - wall);
+    }
+    rc.inner_depth = size.z() - wall;
+    rc.placement.translation = Eigen::Vector3d(0, 0, wall);
     a.receptacles.push_back(rc);
   }
   return a;
