@@ -58,7 +58,18 @@ inline const std::vector<NamedColor>& palette() {
   return p;
 }
 
-/// Category recipe: lathe profile (unit scale) or box, nominal size, mass and material.
+/// A box part of a multi-part asset, in units of the asset's size (centre and half extents are
+/// fractions of size x, y, z; z from the bottom), optionally tilted about x, with its own colour
+/// (an index into palette()) or the asset's main colour (-1).
+struct BoxPart {
+  const char* name;
+  Eigen::Vector3d center;
+  Eigen::Vector3d half;
+  double tilt_x = 0;  ///< rad, about the part's centre
+  int color = -1;
+};
+
+/// Category recipe: lathe profile (unit scale), box, or box parts; nominal size, mass, material.
 struct Recipe {
   const char* category;
   bool lathe;                           ///< false: box
@@ -68,6 +79,8 @@ struct Recipe {
   const char* material;
   bool receptacle = false;
   bool on_side = false;
+  std::vector<BoxPart> parts{};        ///< non-empty: the asset is these boxes (lathe = false)
+  bool long_y = false;                 ///< graspable and longer than 0.085 m along y (a shoe)
 };
 
 /// Radius of a profile at height z (linear between points; clamped to the ends).
@@ -214,9 +227,10 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
   const double aspect = 0.9 + 0.1 * ((i * 3) % 3);
   Eigen::Vector3d size = r.size * s;
   size.z() *= aspect;
+  if (std::string(r.category) == "rubiks_cube") size.z() = size.x();  // a cube
   if (kind == AssetKind::object) {  // graspable: at most 0.085 across
     size.x() = std::min(size.x(), 0.085);
-    size.y() = std::min(size.y(), 0.085);
+    if (!r.long_y) size.y() = std::min(size.y(), 0.085);
   }
   const auto& col = palette()[static_cast<std::size_t>(i * 3 + static_cast<int>(a.category.size())) % palette().size()];
   VisualPart part;
@@ -224,6 +238,12 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
   part.material.base_color = Eigen::Vector3f(col.r, col.g, col.b);
   part.color_name = col.name;
   part.material_name = r.material;
+  if (a.category == "rubiks_cube") {  // a 4 x 4 sticker grid on every face (solid checker, cells of edge / 4)
+    const auto& other = palette()[static_cast<std::size_t>(i * 3 + 4) % palette().size()];
+    part.material.texture = render::TextureKind::checker;
+    part.material.secondary_color = Eigen::Vector3f(other.r, other.g, other.b);
+    part.material.texture_scale = static_cast<float>(4.0 / size.x());
+  }
   geometry::Compound<double> comp;
   geometry::CompoundPart<double> cp;
   const double wall = 0.004;                 // containers: wall and floor thickness, m
@@ -239,6 +259,24 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
       cp.shape = lathe_equal_volume_cylinder(prof, 32);
       cp.position = Eigen::Vector3d(0, 0, 0.5 * size.z());
       comp.parts.push_back(cp);
+    }
+  } else if (!r.parts.empty()) {
+    for (const auto& bp : r.parts) {
+      VisualPart vp = part;
+      vp.name = bp.name;
+      if (bp.color >= 0) {
+        const auto& pc = palette()[static_cast<std::size_t>(bp.color)];
+        vp.material.base_color = Eigen::Vector3f(pc.r, pc.g, pc.b);
+        vp.color_name = pc.name;
+      }
+      geometry::CompoundPart<double> box;
+      const Eigen::Vector3d half = bp.half.cwiseProduct(size);
+      box.shape = geometry::Box<double>{half};
+      box.position = bp.center.cwiseProduct(size);
+      box.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(bp.tilt_x, Eigen::Vector3d::UnitX()));
+      render::append(vp.mesh, render::make_box(half), math::Pose<double>{box.orientation.toRotationMatrix(), box.position});
+      comp.parts.push_back(box);
+      a.visual.push_back(vp);
     }
   } else if (r.receptacle) {
     part.mesh = open_box_mesh(0.5 * size.x(), 0.5 * size.y(), size.z(), wall);
@@ -256,14 +294,22 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
   a.mass = mp.mass;
   a.center_of_mass = mp.center_of_mass;
   a.inertia = mp.inertia;
-  a.visual.push_back(part);
+  if (r.parts.empty()) a.visual.push_back(part);
   a.attributes.color_name = col.name;
   a.attributes.color_rgb = Eigen::Vector3f(col.r, col.g, col.b);
   a.attributes.material_name = r.material;
   a.attributes.size = s < 0.95 ? SizeClass::small : (s < 1.05 ? SizeClass::medium : SizeClass::large);
-  a.attributes.parts = {"body"};
+  a.attributes.parts.clear();
+  for (const auto& vp : a.visual) a.attributes.parts.push_back(vp.name);
   a.bounding_half_extents = 0.5 * size;
   a.bounding_center = Eigen::Vector3d(0, 0, 0.5 * size.z());
+  if (!r.parts.empty()) {  // the union of the parts' vertices
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = Eigen::Vector3f::Constant(-1e30f);
+    for (const auto& vp : a.visual)
+      for (const auto& q : vp.mesh.positions) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+    a.bounding_half_extents = 0.5 * (hi - lo).cast<double>();
+    a.bounding_center = 0.5 * (hi + lo).cast<double>();
+  }
   a.resting_poses.push_back(RestingPose{Eigen::Quaterniond::Identity(), 0.0, "upright"});
   if (r.on_side) {
     // Rotate +90 deg about x: the axis lies along -y; the origin (footprint centre) sits one radius up.
@@ -275,7 +321,7 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
     GraspAnnotation g;
     math::Matrix3<double> R;
     R << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // x closing along the asset's x, z (approach) straight down
-    const double top = size.z();
+    const double top = a.bounding_center.z() + a.bounding_half_extents.z();
     const double frame_z = std::max(top + gg.palm_clearance + gg.palm_thickness,
                                     gg.table_clearance + gg.palm_thickness + gg.finger_length);
     g.grasp.rotation = R;
@@ -288,6 +334,17 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
     const double lo = std::max(0.0, frame_z - gg.palm_thickness - gg.finger_length);
     const double hi = std::min(top, frame_z - gg.palm_thickness);
     g.width = r.lathe ? 2.0 * max_profile_radius(prof, lo, hi) : size.x();
+    if (!r.parts.empty()) {  // the parts (tilted about x only: x extents unchanged) reaching into [lo, hi]
+      double xlo = 1e30, xhi = -1e30;
+      for (const auto& bp : r.parts) {
+        const Eigen::Vector3d c = bp.center.cwiseProduct(size), h = bp.half.cwiseProduct(size);
+        const double hz = std::abs(std::cos(bp.tilt_x)) * h.z() + std::abs(std::sin(bp.tilt_x)) * h.y();
+        if (c.z() + hz <= lo || c.z() - hz >= hi) continue;
+        xlo = std::min(xlo, c.x() - h.x());
+        xhi = std::max(xhi, c.x() + h.x());
+      }
+      g.width = xhi - xlo;
+    }
     a.grasps.push_back(g);
   }
   if (r.receptacle) {
@@ -324,7 +381,11 @@ inline std::vector<Asset> object_catalog() {
       {"can", true, {{0.9, 0}, {1, 0.05}, {1, 0.93}, {0.88, 1}}, V(0.066, 0.066, 0.12), 0.25, "metal", false, true},
       {"cup", true, {{0.75, 0}, {1, 1}}, V(0.075, 0.075, 0.1), 0.12, "ceramic", true},
       {"sand_clock", true, {{1, 0}, {1, 0.05}, {0.2, 0.5}, {1, 0.95}, {1, 1}}, V(0.07, 0.07, 0.14), 0.2, "glass"},
-      {"shoe", false, {}, V(0.08, 0.08, 0.09), 0.28, "fabric"},
+      {"shoe", false, {}, V(0.08, 0.2, 0.09), 0.28, "fabric", false, false,
+       {{"sole", V(0, 0, 0.075), V(0.5, 0.5, 0.075), 0, 4},
+        {"toe", V(0, -0.2, 0.3), V(0.45, 0.3, 0.15)},
+        {"heel", V(0, 0.3, 0.55), V(0.45, 0.2, 0.4)}},
+       true},
       {"candle_stick", true, {{1, 0}, {1, 0.1}, {0.35, 0.2}, {0.35, 1}}, V(0.07, 0.07, 0.2), 0.2, "metal"},
       {"box_drink", false, {}, V(0.06, 0.04, 0.11), 0.25, "cardboard"},
       {"kettle", true, {{0.8, 0}, {1, 0.4}, {0.8, 0.85}, {0.3, 1}}, V(0.085, 0.085, 0.13), 0.3, "metal"},
@@ -350,19 +411,28 @@ inline std::vector<Asset> obstacle_catalog() {
   using V = Eigen::Vector3d;
   const std::vector<Recipe> recipes{
       {"book", false, {}, V(0.16, 0.24, 0.03), 0.5, "paper"},
-      {"laptop", false, {}, V(0.32, 0.22, 0.02), 1.5, "metal"},
-      {"monitor", false, {}, V(0.5, 0.18, 0.35), 4.0, "plastic"},
+      {"laptop", false, {}, V(0.32, 0.22, 0.2), 1.5, "metal", false, false,
+       {{"base", V(0, -0.06, 0.05), V(0.5, 0.44, 0.05)},
+        {"screen", V(0, 0.45, 0.61), V(0.5, 0.47, 0.025), 1.35, 5}}},
+      {"monitor", false, {}, V(0.5, 0.18, 0.35), 4.0, "plastic", false, false,
+       {{"stand", V(0, 0, 0.025), V(0.25, 0.5, 0.025)},
+        {"neck", V(0, 0.1, 0.175), V(0.04, 0.08, 0.125)},
+        {"screen", V(0, 0.1, 0.65), V(0.5, 0.1, 0.35), 0, 5}}},
       {"lamp", true, {{1, 0}, {1, 0.05}, {0.1, 0.1}, {0.1, 0.7}, {0.8, 0.75}, {0.5, 1}}, V(0.18, 0.18, 0.4), 1.2, "metal"},
       {"vase", true, {{0.6, 0}, {1, 0.4}, {0.4, 0.85}, {0.55, 1}}, V(0.14, 0.14, 0.28), 1.0, "ceramic"},
       {"plant_pot", true, {{0.75, 0}, {1, 1}}, V(0.16, 0.16, 0.15), 1.5, "ceramic"},
-      {"phone", false, {}, V(0.075, 0.15, 0.009), 0.18, "glass"},
+      {"phone", false, {}, V(0.075, 0.15, 0.009), 0.18, "glass", false, false,
+       {{"body", V(0, 0, 0.4), V(0.5, 0.5, 0.4)},
+        {"screen", V(0, 0.02, 0.9), V(0.44, 0.44, 0.1), 0, 5}}},
       {"keyboard", false, {}, V(0.44, 0.14, 0.03), 0.7, "plastic"},
       {"mouse", false, {}, V(0.065, 0.11, 0.035), 0.09, "plastic"},
       {"speaker", false, {}, V(0.12, 0.12, 0.2), 1.5, "wood"},
       {"clock", true, cyl(), V(0.2, 0.2, 0.05), 0.6, "plastic"},
       {"jar", true, {{1, 0}, {1, 0.85}, {0.8, 0.9}, {0.8, 1}}, V(0.1, 0.1, 0.15), 0.5, "glass"},
       {"toy", false, {}, V(0.1, 0.08, 0.12), 0.2, "plastic"},
-      {"tissue_box", false, {}, V(0.24, 0.12, 0.09), 0.3, "cardboard"},
+      {"tissue_box", false, {}, V(0.24, 0.12, 0.11), 0.3, "cardboard", false, false,
+       {{"box", V(0, 0, 0.4), V(0.5, 0.5, 0.4)},
+        {"tissue", V(0, 0, 0.9), V(0.2, 0.15, 0.1), 0, 4}}},
       {"stapler", false, {}, V(0.04, 0.15, 0.05), 0.3, "metal"},
       {"tape_dispenser", false, {}, V(0.06, 0.14, 0.07), 0.4, "plastic"},
       {"globe", true, {{0.4, 0}, {0.4, 0.1}, {1, 0.5}, {0.4, 1}}, V(0.25, 0.25, 0.35), 1.0, "plastic"},
