@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -140,7 +141,7 @@ int main(int argc, char** argv) {
   CLI::App app{"List the ManiSoft asset catalogues; export meshes; render a contact sheet"};
   bool markdown = false;
   std::string export_dir, sheet_path;
-  int columns = 20, tile = 160, msaa = 4, downscale = 1;
+  int columns = 20, tile = 160, msaa = 4, downscale = 1, levels = 256;
   app.add_flag("--markdown", markdown, "print the category table as Markdown");
   app.add_option("--export", export_dir, "write every visual mesh as an OBJ file into this folder");
   app.add_option("--contact-sheet", sheet_path, "render every asset into this PNG (legend: the same name with .csv)");
@@ -148,6 +149,8 @@ int main(int argc, char** argv) {
   app.add_option("--tile", tile, "contact sheet: rendered tile size, pixels")->check(CLI::Range(16, 1024));
   app.add_option("--msaa", msaa, "contact sheet: OpenGL multisampling (0, 2, 4, 8)")->check(CLI::IsMember({0, 2, 4, 8}));
   app.add_option("--downscale", downscale, "contact sheet: box-filter each tile down by this factor")->check(CLI::Range(1, 8));
+  app.add_option("--levels", levels, "contact sheet: quantize each colour channel to this many levels (smaller PNG)")
+      ->check(CLI::Range(2, 256));
   CLI11_PARSE(app, argc, argv);
   try {
     using namespace manisoft::assets;
@@ -199,7 +202,11 @@ int main(int argc, char** argv) {
       if (tile % downscale != 0) manisoft::detail::fail("--tile ", tile, " must be a multiple of --downscale ", downscale);
 #ifdef MANISOFT_HAVE_RENDER
       int w = 0, h = 0;
-      const auto sheet = contact_sheet(all, columns, tile, msaa, downscale, w, h);
+      auto sheet = contact_sheet(all, columns, tile, msaa, downscale, w, h);
+      if (levels < 256) {
+        const double step = 255.0 / (levels - 1);
+        for (auto& c : sheet) c = static_cast<std::uint8_t>(std::lround(std::round(c / step) * step));
+      }
       const fs::path png(sheet_path);
       if (png.has_parent_path()) fs::create_directories(png.parent_path());
       manisoft::render::write_png_rgb(png, w, h, sheet);
