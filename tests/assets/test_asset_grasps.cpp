@@ -6,8 +6,8 @@
 //    within its limits, and lifts the object; independently, the object's visual mesh over the
 //    fingers' height range lies between the open fingers and its extent along the closing axis
 //    is the annotated width;
-//  - the approach, grasp and lift poses of every grasp, for the object at three reachable table
-//    spots (x 0.50, 0.55 and 0.60 m, y 0: the middle of the band the tool-down arm reaches,
+//  - the approach, grasp and lift poses of every grasp, for the object at two reachable table
+//    spots (x 0.50 and 0.60 m, y 0: in the middle of the band the tool-down arm reaches,
 //    DESIGN.md section 10), are equilibria of the arm within its actuation limits (the inverse
 //    statics, as world_demo and the reach environment use it; lift with the heaviest graspable
 //    payload). Closer to the mount (x 0.45) the high approach and lift poses need up to 1.2 times
@@ -158,7 +158,7 @@ TEST_CASE("every grasp annotation closes the gripper on its object on the table"
       interaction::ParallelGripper gripper(gp);
       gripper.attach(w.add_body(ee.body));
       const Vector3d x0 = w.position(object);
-      for (int i = 0; i < 100; ++i) step_kinematic(w, gripper, Vector3d::Zero());
+      for (int i = 0; i < 50; ++i) step_kinematic(w, gripper, Vector3d::Zero());
       // The open gripper at the grasp pose does not disturb the object.
       CHECK((w.position(object) - x0).norm() < 1e-3);
       CHECK(gripper.finger_width() == Approx(gp.open_width));
@@ -169,11 +169,11 @@ TEST_CASE("every grasp annotation closes the gripper on its object on the table"
       CHECK(gripper.state() == 1);
       CHECK(gripper.finger_width() > 0);
       CHECK(gripper.finger_width() < gp.open_width);
-      // Lift about 5 cm (speed ramped to 0.3 m/s over 0.05 s): the weld carries the object.
-      for (int i = 0; i < 1000; ++i) step_kinematic(w, gripper, Vector3d(0, 0, 0.3 * std::min(1.0, i / 250.0)));
+      // Lift 3.5 cm (speed ramped to 0.3 m/s over 0.05 s): the weld carries the object.
+      for (int i = 0; i < 700; ++i) step_kinematic(w, gripper, Vector3d(0, 0, 0.3 * std::min(1.0, i / 250.0)));
       REQUIRE(gripper.held());
       CHECK(!gripper.slipped());
-      CHECK(w.position(object).z() - x0.z() > 0.045);
+      CHECK(w.position(object).z() - x0.z() > 0.03);
       ++checked;
     }
   }
@@ -191,7 +191,7 @@ TEST_CASE("every grasp's approach, grasp and lift poses are within the arm's act
   manisoft::rod::InverseStatics<double> loaded(manisoft::rod::make_arm_model(arm, gp.mass + heaviest), {}, settings.limits);
   const double table_top = world::tabletop_table().top_center.z();
   int solved = 0;
-  for (double x : {0.50, 0.55, 0.60}) {
+  for (double x : {0.50, 0.60}) {
     const Pose<double> place = at(x, 0.0, table_top);
     for (const Asset& a : objects) {
       for (std::size_t k = 0; k < a.grasps.size(); ++k) {
@@ -213,7 +213,7 @@ TEST_CASE("every grasp's approach, grasp and lift poses are within the arm's act
       }
     }
   }
-  CHECK(solved >= 3 * 3 * 109);
+  CHECK(solved >= 2 * 3 * 109);
 }
 
 TEST_CASE("every container holds a small cube dropped into it", "[assets][receptacle]") {
@@ -240,7 +240,7 @@ TEST_CASE("every container holds a small cube dropped into it", "[assets][recept
       cube.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(20.0 * std::numbers::pi / 180.0, Vector3d::UnitZ()));
       cube.name = "cube";
       const BodyId c = w.add_body(cube);
-      for (int i = 0; i < 2500; ++i) w.step(kDt);  // 0.5 s
+      for (int i = 0; i < 1500; ++i) w.step(kDt);  // 0.3 s
       // Inside the inner volume (in the opening frame: resting on the floor, inner_depth below the
       // rim, within the radius / half extents), at rest, and the container still where it was.
       const Vector3d p = opening.rotation.transpose() * (w.center_of_mass(c) - opening.translation);
