@@ -29,6 +29,7 @@ namespace {
 namespace fs = std::filesystem;
 using manisoft::assets::Asset;
 
+#ifdef MANISOFT_HAVE_RENDER
 /// Writes `text` to `path` through a temporary file and a rename (never a half-written file).
 void write_text_atomically(const fs::path& path, const std::string& text) {
   fs::path tmp = path;
@@ -64,7 +65,6 @@ std::string legend_csv(const std::vector<Asset>& all, int columns) {
   return o.str();
 }
 
-#ifdef MANISOFT_HAVE_RENDER
 /// 3 x 5 pixel digits (rows top to bottom, 3 bits a row, most significant = left).
 constexpr std::array<std::array<std::uint8_t, 5>, 10> kDigits{{{7, 5, 5, 5, 7}, {2, 6, 2, 2, 7}, {7, 1, 7, 4, 7}, {7, 1, 7, 1, 7},
                                                               {5, 5, 7, 1, 1}, {7, 4, 7, 1, 7}, {7, 4, 7, 5, 7}, {7, 1, 1, 1, 1},

@@ -62,8 +62,8 @@ inline render::Camera frame_asset(const Asset& asset, const AssetViewOptions& op
 }
 
 /// Render snapshot of `asset` (visual parts with their materials, all with `object_id`; the
-/// ground slab, if any, with id object_id + 1) framed by frame_asset, lit from behind the camera's
-/// left shoulder.
+/// ground slab, if any, with id object_id + 1) framed by frame_asset, lit from above and behind
+/// the camera's right shoulder (shadows fall to the image's left).
 inline void asset_scene(const Asset& asset, const AssetViewOptions& options, render::SceneDescription& scene,
                         render::FrameState& frame, std::uint16_t object_id = 1) {
   scene = render::SceneDescription{};
@@ -93,7 +93,7 @@ inline void asset_scene(const Asset& asset, const AssetViewOptions& options, ren
   }
   const render::Camera cam = frame_asset(asset, options);
   scene.cameras = {cam};
-  // Light travels down and away from a point above and to the left of the camera.
+  // The light travels along the view, toward the image's left and down.
   const Eigen::Vector3d view = (cam.look_at - cam.position).normalized();
   const Eigen::Vector3d left = Eigen::Vector3d::UnitZ().cross(view).normalized();
   scene.lighting.kind = render::LightKind::directional;
