@@ -60,7 +60,8 @@ inline const std::vector<NamedColor>& palette() {
 
 /// A box part of a multi-part asset, in units of the asset's size (centre and half extents are
 /// fractions of size x, y, z; z from the bottom), optionally tilted about x, with its own colour
-/// (an index into palette()) or the asset's main colour (-1).
+/// (an index into palette()) or the asset's main colour (-1). The first part is the body (main
+/// colour): the language layer names the later ones ("the red shoe with the white sole").
 struct BoxPart {
   const char* name;
   Eigen::Vector3d center;
@@ -382,9 +383,9 @@ inline std::vector<Asset> object_catalog() {
       {"cup", true, {{0.75, 0}, {1, 1}}, V(0.075, 0.075, 0.1), 0.12, "ceramic", true},
       {"sand_clock", true, {{1, 0}, {1, 0.05}, {0.2, 0.5}, {1, 0.95}, {1, 1}}, V(0.07, 0.07, 0.14), 0.2, "glass"},
       {"shoe", false, {}, V(0.08, 0.2, 0.09), 0.28, "fabric", false, false,
-       {{"sole", V(0, 0, 0.075), V(0.5, 0.5, 0.075), 0, 4},
-        {"toe", V(0, -0.2, 0.3), V(0.45, 0.3, 0.15)},
-        {"heel", V(0, 0.3, 0.55), V(0.45, 0.2, 0.4)}},
+       {{"upper", V(0, -0.2, 0.3), V(0.45, 0.3, 0.15)},
+        {"heel", V(0, 0.3, 0.55), V(0.45, 0.2, 0.4)},
+        {"sole", V(0, 0, 0.075), V(0.5, 0.5, 0.075), 0, 4}},
        true},
       {"candle_stick", true, {{1, 0}, {1, 0.1}, {0.35, 0.2}, {0.35, 1}}, V(0.07, 0.07, 0.2), 0.2, "metal"},
       {"box_drink", false, {}, V(0.06, 0.04, 0.11), 0.25, "cardboard"},
