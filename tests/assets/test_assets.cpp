@@ -10,6 +10,7 @@
 #include <set>
 #include <tuple>
 
+#include "manisoft/assets/asset_view.hpp"
 #include "manisoft/assets/catalog.hpp"
 
 using namespace manisoft;
@@ -166,4 +167,40 @@ TEST_CASE("catalogue is deterministic", "[assets]") {
     }
     CHECK(a[i].mass == b[i].mass);
   }
+}
+
+// The contact sheet's framing (asset_view.hpp): every corner of every asset's bounding box
+// projects inside its tile, and the box is not a speck (its projection spans at least a third
+// of the tile).
+TEST_CASE("asset views frame the whole bounding box", "[assets]") {
+  AssetViewOptions opt;
+  opt.width = 160;
+  opt.height = 120;
+  for (const auto& a : all_assets()) {
+    INFO(a.id);
+    const auto model = render::camera_model(frame_asset(a, opt));
+    double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner =
+          a.bounding_center + Eigen::Vector3d(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1).cwiseProduct(a.bounding_half_extents);
+      const Eigen::Vector2d uv = model.project(corner);
+      umin = std::min(umin, uv.x()), umax = std::max(umax, uv.x());
+      vmin = std::min(vmin, uv.y()), vmax = std::max(vmax, uv.y());
+    }
+    CHECK(umin >= 0);
+    CHECK(vmin >= 0);
+    CHECK(umax <= opt.width - 1);
+    CHECK(vmax <= opt.height - 1);
+    CHECK(std::max(umax - umin, vmax - vmin) > opt.height / 3.0);
+  }
+  render::SceneDescription scene;
+  render::FrameState frame;
+  const auto objects = object_catalog();
+  asset_scene(objects.front(), opt, scene, frame, 7);
+  CHECK(scene.instances.size() == objects.front().visual.size() + 1);  // + the ground slab
+  CHECK(frame.instance_poses.size() == scene.instances.size());
+  CHECK(scene.instances.front().object_id == 7);
+  Asset flat = objects.front();
+  flat.bounding_half_extents.setZero();
+  CHECK_THROWS_AS(frame_asset(flat, opt), manisoft::Error);
 }
