@@ -186,6 +186,14 @@ class InverseStatics {
     return Pose{directors_[n_elements() - 1].transpose(), tip_};
   }
 
+  /// Forward statics: node positions ((n + 1) x 3, lab) of the shape with coefficients c (does
+  /// not change the committed solution; `positions` must have n + 1 rows). Does not allocate.
+  void shape_positions(const Coefficients& c, Array3& positions) {
+    if (positions.rows() != n_elements() + 1) manisoft::detail::fail("InverseStatics::shape_positions: positions has ", positions.rows(), " rows, expected ", n_elements() + 1);
+    shape(c);
+    for (int k = 0; k <= n_elements(); ++k) positions.row(k) = positions_cache_[k].transpose();
+  }
+
   /// Solves for `target` starting from the last solution (warm start). Does not allocate.
   InverseStaticsResult<Scalar> solve(const Pose& target) { return solve_from(target, coefficients_); }
 
