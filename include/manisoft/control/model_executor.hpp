@@ -240,7 +240,7 @@ class ModelExecutor {
   /// warm-started along the path and checked for continuity (see the header comment). `steps`
   /// may be 0 only for a path of length zero (a point target: hold the current shape). A refused
   /// path (report.accepted false, with the reason) leaves the executor as it was. Allocates
-  /// nothing (the knot table is reserved at construction).
+  /// nothing (the knot table is reserved at construction; on a copy, at its first path).
   ///
   /// `max_node_step` (m per control step; infinity: no bound) bounds the planned speed of every
   /// node: the knot shapes' largest node displacement over each knot interval, divided by the
@@ -271,6 +271,8 @@ class ModelExecutor {
       k = std::min({static_cast<int>(std::ceil(need)), settings_.max_knots, std::max(steps, 1)});
     }
     knots_.clear();
+    // (a copied executor's table lost its reserve: restored here, once)
+    knots_.reserve(static_cast<std::size_t>(settings_.max_knots) << settings_.max_subdivisions);
     knots_.push_back(Knot{Scalar(0), c0});
     knot_positions_ = statics_.desired_state().positions;
     max_node_rate_ = 0;
@@ -315,6 +317,29 @@ class ModelExecutor {
     adapt_count_ = 0;
     last_path_ = report;
     return report;
+  }
+
+  /// Jumps to the end of the current path or shape ramp (and of a payload ramp) without running it: the shape
+  /// target becomes the path's last knot. For planners that chain track_line() calls to check a
+  /// whole sequence before running it (on a copy of the executor).
+  void complete_path() {
+    if (tracking_) {
+      statics_.set_coefficients(knots_.back().c);
+      knots_.front() = knots_.back();
+      knots_.front().t = 0;
+      knots_.resize(1);
+      path_steps_ = 0;
+      ramp_steps_ = 0;
+      steps_ = 0;
+    } else if (has_target_ && steps_ < ramp_steps_) {
+      statics_.set_coefficients(ramp_end_);
+      ramp_steps_ = 0;
+      steps_ = 0;
+    }
+    if (payload_step_ < payload_steps_) {
+      payload_step_ = payload_steps_;
+      apply_payload(payload_to_);
+    }
   }
 
   /// Tells the executor the end-effector holds an object of `mass` kg whose centre of mass is at
@@ -619,7 +644,9 @@ class ModelExecutor {
   bool plan_interval(Scalar u0, Scalar u1, Scalar steps, int depth, Vector3& tip_previous, PathReport<Scalar>& report) {
     const Coefficients from = knots_.back().c;
     const Pose pose = path_pose(quintic(u1));
-    const rod::InverseStaticsResult<Scalar> r = statics_.solve_from(pose, from);
+    // The smallest shape change that meets the knot (continuity); the full solver only if that fails.
+    rod::InverseStaticsResult<Scalar> r = statics_.solve_near(pose, from);
+    if (!r.within_limits) r = statics_.solve_from(pose, from);
     const Coefficients to = statics_.coefficients();
     bool good = r.within_limits;
     Scalar blend_path = 0;

@@ -95,6 +95,7 @@ struct PickPlaceResult {
   PickPlaceTask task{};
   bool success = false;
   std::string failure;             ///< "" on success
+  std::string detail;              ///< more on a failure (a refused path: the phase and the planner's reason)
   int steps = 0;                   ///< control steps taken (successful or not)
   double cpu_seconds = 0;          ///< process CPU time of the episode (simulation + executor)
   double executor_seconds = 0;     ///< CPU time inside act() and path set-ups
@@ -126,7 +127,6 @@ class PickPlaceRunner {
       : config_(validated(config)),
         params_(world::tabletop_arm_parameters()),
         model_(rod::make_arm_model(params_, gripper_.mass)),
-        statics_(model_, {}, world_settings().limits),
         world_(Rod(params_, config_.dt, rod::damping::AnalyticalLinear<double>(config_.rod_damping)), world_settings()),
         executor_(model_, world_settings().limits, config_.executor) {
     table_ = world::tabletop_table();
@@ -173,13 +173,18 @@ class PickPlaceRunner {
       t.place = t.cube + distance * Vec3(std::cos(direction), std::sin(direction), 0);
       if (t.place.x() < 0.30 || t.place.x() > 0.62 || std::abs(t.place.y()) > 0.25) continue;
       t.gripper_yaw = t.cube_yaw - (pi / 2) * std::round(t.cube_yaw / (pi / 2));
+      // The whole sequence is planned from home (on a copy of the home executor): every path
+      // accepted (continuous, within the limits with the cube's weight once it is held) and
+      // every waypoint shape clear of the table top.
+      planner_ = home_executor_;
+      const auto w = waypoints(t, Vec3::Zero());
+      const Vec3 nominal_in_hand = w[1].rotation.transpose() * (t.cube - w[1].translation);
       bool ok = true;
-      for (const Pose& w : waypoints(t, Vec3::Zero())) {
-        const auto r = statics_.solve_cold(w);
-        if (!r.within_limits || statics_.desired_state().positions.col(2).minCoeff() < top_ + config_.table_clearance) {
-          ok = false;
-          break;
-        }
+      for (std::size_t i = 0; i < w.size() && ok; ++i) {
+        if (i == 2) planner_.set_payload(config_.cube_mass, nominal_in_hand);
+        ok = planner_.track_line(w[i], 100).accepted;
+        planner_.complete_path();
+        ok = ok && planner_.statics().desired_state().positions.col(2).minCoeff() >= top_ + config_.table_clearance;
       }
       if (ok) return t;
     }
@@ -216,7 +221,10 @@ class PickPlaceRunner {
       const double setup = double(std::clock() - s0) / CLOCKS_PER_SEC;
       res.executor_seconds += setup;
       res.max_setup_seconds = std::max(res.max_setup_seconds, setup);
-      if (!report.accepted) return false;
+      if (!report.accepted) {
+        res.detail = std::string(pick_place_phase_name(phase)) + ": " + report.reason;
+        return false;
+      }
       res.max_planned_ratio = std::max(res.max_planned_ratio, report.ratio);
       target = goal;
       seg_path = 0;
@@ -433,10 +441,10 @@ class PickPlaceRunner {
   interaction::ParallelGripperParameters gripper_{};
   rod::RodParameters<double> params_;
   rod::ArmModel<double> model_;
-  rod::InverseStatics<double> statics_;
   World world_;
   Executor executor_;
   Executor home_executor_{executor_};
+  Executor planner_{executor_};
   world::TableDesc table_;
   double top_ = 0.75;
   rigid::BodyId cube_ = 0;
