@@ -47,6 +47,30 @@
 //             moves by  p_s <- p_s + K e_p,  R_s <- Exp(K e_R) R_s,  and the inverse statics is
 //             re-solved (warm started) for the shifted target: integral action on the SE(3) tip
 //             error for what the stiffness estimate does not explain (an unknown load).
+//   tracking (track_line): the executor follows a time-parameterised SE(3) path, a straight
+//             line from the current shape target's tip pose to a goal (position linear, rotation
+//             along the geodesic) with quintic (minimum-jerk) timing over a given number of
+//             control steps. At set-up the path is cut into knots (at most knot_spacing m or
+//             knot_angle rad apart, at least one per max_knot_steps) and the inverse statics is
+//             solved at each knot warm-started from the previous knot's shape, so the shape target
+//             moves continuously with the path and never restarts a ramp; between knots the
+//             curvature coefficients are interpolated linearly in time. Continuity check: the tip
+//             path of each knot-to-knot blend (sampled) must stay within path_ratio_limit times
+//             the straight distance (plus 1 mm); a knot that fails it (or does not converge within
+//             the limits) is subdivided, up to max_subdivisions times, else the whole path is
+//             refused and reported (PathReport) and the executor keeps its current shape target.
+//             A point target is a path of length zero. While tracking, the node velocity feedback
+//             acts on v - v*, v* the desired shape's node velocity (finite difference along the
+//             schedule), so the arm is not braked against the motion it is asked to make.
+//   payload   set_payload(m, r): a held object of mass m whose centre is at r in the
+//             end-effector frame; the feed-forward adds its weight at the tip (the shear couple of
+//             inverse_statics.hpp) and cancels its couple r x m g on the last element, ramped in
+//             over payload_ramp_steps control steps.
+//   outer-loop corrections are ramped: a re-solved shape target is blended in over outer_period
+//             control steps, and one whose blend tip path fails the continuity check is refused.
+//   reported state: converged() (the path's end reached: within converged_position /
+//             converged_rotation of the target and every observed node slower than
+//             converged_speed), saturated(), predicted_shape(step) along the current path.
 // Only the observation is used: target, node positions/velocities, the end-effector pose.
 // No heap allocation in act() after the first call for a target; the inverse statics set-up of a
 // new target runs inside that call.
@@ -55,6 +79,8 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 #include <Eigen/Geometry>
 
 #include "manisoft/control/executor.hpp"
@@ -84,6 +110,34 @@ struct ModelExecutorSettings {
   Scalar twist_gain = Scalar(20);          ///< N m/rad: twist couple -k phi_tip (s_k / L) on the tip twist error
   Scalar twist_damping = Scalar(0);        ///< N m s/rad: twist couple -c w_tip (s_k / L) from end-effector
                                            ///< pose differences (0: off; BENCHMARKS.md has the runs)
+  // ---- trajectory tracking (track_line)
+  Scalar knot_spacing = Scalar(0.01);      ///< m of tip travel between knots of a path, at most
+  Scalar knot_angle = Scalar(0.05);        ///< rad of tip rotation between knots, at most
+  int max_knot_steps = 25;                 ///< control steps between knots, at most
+  int max_knots = 120;                     ///< knots of one path (before subdivision)
+  int max_subdivisions = 3;                ///< halvings of a knot interval that fails the continuity check
+  Scalar path_ratio_limit = Scalar(1.5);   ///< knot-to-knot tip path / straight distance, at most
+  bool velocity_feedforward = true;        ///< track v - v* (desired node velocities) on paths
+  // ---- payload and reported state
+  int payload_ramp_steps = 40;             ///< control steps to ramp a payload change in
+  Scalar converged_position = Scalar(0.005);  ///< m
+  Scalar converged_rotation = Scalar(0.05);   ///< rad
+  Scalar converged_speed = Scalar(0.05);      ///< m/s, every observed node
+};
+
+/// What track_line() planned (or why it refused).
+template <typename Scalar>
+struct PathReport {
+  bool accepted = false;
+  const char* reason = "";       ///< why a path was refused ("" when accepted)
+  int steps = 0;                 ///< control steps of the path
+  int knots = 0;                 ///< knots after subdivision (the start included)
+  int subdivisions = 0;          ///< knot intervals halved by the continuity check
+  Scalar straight = 0;           ///< |p_goal - p_start|, m
+  Scalar tip_path = 0;           ///< sampled tip path of the planned shape sequence, m
+  Scalar ratio = 1;              ///< tip_path / straight (1 for paths shorter than 1 mm)
+  Scalar max_torque_ratio = 0;   ///< largest |tau_ff| / limit over the knots
+  Scalar max_node_step = 0;      ///< planned peak node speed, m per control step (after any stretch)
 };
 
 template <typename ScalarType>
@@ -94,6 +148,7 @@ class ModelExecutor {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
   using Pose = math::Pose<Scalar>;
+  using Coefficients = typename rod::InverseStatics<Scalar>::Coefficients;
 
   ModelExecutor(rod::ArmModel<Scalar> model, rod::ActuationLimits<Scalar> limits, ModelExecutorSettings<Scalar> settings = {},
                 rod::InverseStaticsSettings<Scalar> statics = {})
@@ -119,8 +174,25 @@ class ModelExecutor {
     positions_.setZero(n + 1, 3);
     velocities_.setZero(n + 1, 3);
     direction_.setZero(n + 1, 3);
+    manisoft::detail::require_positive("ModelExecutor knot_spacing", settings_.knot_spacing);
+    manisoft::detail::require_positive("ModelExecutor knot_angle", settings_.knot_angle);
+    if (settings_.max_knot_steps < 1) manisoft::detail::fail("ModelExecutor max_knot_steps = ", settings_.max_knot_steps, " must be >= 1");
+    if (settings_.max_knots < 1) manisoft::detail::fail("ModelExecutor max_knots = ", settings_.max_knots, " must be >= 1");
+    if (settings_.max_subdivisions < 0 || settings_.max_subdivisions > 8)
+      manisoft::detail::fail("ModelExecutor max_subdivisions = ", settings_.max_subdivisions, " must be in [0, 8]");
+    if (!(settings_.path_ratio_limit >= Scalar(1))) manisoft::detail::fail("ModelExecutor path_ratio_limit = ", settings_.path_ratio_limit, " must be >= 1");
+    if (settings_.payload_ramp_steps < 0) manisoft::detail::fail("ModelExecutor payload_ramp_steps = ", settings_.payload_ramp_steps, " must be >= 0");
+    manisoft::detail::require_positive("ModelExecutor converged_position", settings_.converged_position);
+    manisoft::detail::require_positive("ModelExecutor converged_rotation", settings_.converged_rotation);
+    manisoft::detail::require_positive("ModelExecutor converged_speed", settings_.converged_speed);
     node_mass_ = statics_.model().rod.node_masses;
     node_mass_[n] += statics_.model().payload_mass;
+    tip_node_mass_ = node_mass_[n];
+    desired_velocity_.setZero(n + 1, 3);
+    previous_desired_.setZero(n + 1, 3);
+    knot_positions_.setZero(n + 1, 3);
+    knots_.reserve(static_cast<std::size_t>(settings_.max_knots) << settings_.max_subdivisions);
+    knots_.push_back(Knot{Scalar(0), statics_.coefficients()});
   }
 
   /// Forgets the target; the arm is assumed straight at rest (the shape ramp starts there).
@@ -128,6 +200,13 @@ class ModelExecutor {
     has_target_ = false;
     has_previous_ = false;
     steps_ = 0;
+    tracking_ = false;
+    outer_ramp_ = 0;
+    payload_ = payload_from_ = payload_to_ = Scalar(0);
+    payload_offset_.setZero();
+    payload_step_ = payload_steps_ = 0;
+    node_mass_[statics_.n_elements()] = tip_node_mass_;
+    converged_ = saturated_ = false;
     statics_.set_model_estimates(Scalar(1), statics_.model().payload_mass);
     statics_.set_coefficients(rod::InverseStatics<Scalar>::Coefficients::Zero());
     adapt_count_ = 0;
@@ -138,15 +217,162 @@ class ModelExecutor {
     validate_observation(o, n + 1);
     if (action.rows() != n) action.resize(n, 3);  // allocates only if the caller passed a wrong size
     if (!has_target_ || !same_pose(o.target, target_)) set_target(o.target);
-    interpolate(o);
+    const Scalar control_dt = has_previous_ && o.time > previous_time_ ? o.time - previous_time_ : Scalar(0);
+    advance_payload();
     advance_shape_target(o);
+    update_desired_velocity(control_dt);
+    interpolate(o);
     const Scalar twist_rate = tip_twist_rate(o);
+    const Scalar max_speed = o.node_velocities.rowwise().norm().maxCoeff();
     const bool adapting = settings_.stiffness_gain > Scalar(0) && steps_ >= ramp_steps_ + settings_.estimate_delay &&
-                          o.node_velocities.rowwise().norm().maxCoeff() <= settings_.estimate_speed_gate;
-    const bool saturated = feedforward_plus_feedback(o, twist_rate, action);
+                          max_speed <= settings_.estimate_speed_gate;
+    saturated_ = feedforward_plus_feedback(o, twist_rate, action);
     // A saturated actuator does not apply the torque the estimate assumes: no update then.
-    if (adapting && !saturated) accumulate_estimate(o);
+    if (adapting && !saturated_) accumulate_estimate(o);
     ++steps_;
+    converged_ = steps_ >= ramp_steps_ && max_speed <= settings_.converged_speed &&
+                 (o.end_effector.translation - target_.translation).norm() <= settings_.converged_position &&
+                 math::so3::log(Matrix3(target_.rotation * o.end_effector.rotation.transpose())).norm() <= settings_.converged_rotation;
+  }
+
+  /// Follows the straight SE(3) line from the current shape target's tip pose to `goal` over
+  /// `steps` control steps (quintic timing), without a ramp: the knots' inverse statics are
+  /// warm-started along the path and checked for continuity (see the header comment). `steps`
+  /// may be 0 only for a path of length zero (a point target: hold the current shape). A refused
+  /// path (report.accepted false, with the reason) leaves the executor as it was. Allocates
+  /// nothing (the knot table is reserved at construction; on a copy, at its first path).
+  ///
+  /// `max_node_step` (m per control step; infinity: no bound) bounds the planned speed of every
+  /// node: the knot shapes' largest node displacement over each knot interval, divided by the
+  /// interval's control steps. A path planned faster is slowed (its steps stretched, reported in
+  /// report.steps); the quintic timing is kept.
+  PathReport<Scalar> track_line(const Pose& goal, int steps, Scalar max_node_step = std::numeric_limits<Scalar>::infinity()) {
+    math::require_valid_pose(goal, "executor path goal");
+    if (steps < 0) manisoft::detail::fail("executor: track_line steps = ", steps, " must be >= 0");
+    if (!(max_node_step > Scalar(0))) manisoft::detail::fail("executor: track_line max_node_step = ", max_node_step, " must be > 0");
+    PathReport<Scalar> report;
+    report.steps = steps;
+    const Coefficients c0 = statics_.coefficients();
+    const Pose p0 = statics_.desired_tip_pose();
+    path_start_ = p0;
+    path_goal_ = goal;
+    path_rotation_ = math::so3::log(Matrix3(p0.rotation.transpose() * goal.rotation));
+    report.straight = (goal.translation - p0.translation).norm();
+    const Scalar angle = path_rotation_.norm();
+    const bool zero_length = report.straight < Scalar(1e-9) && angle < Scalar(1e-9);
+    if (steps == 0 && !zero_length) {
+      report.reason = "a path of non-zero length needs steps >= 1";
+      return report;
+    }
+    int k = 1;
+    if (!zero_length) {
+      const Scalar need = std::max({report.straight / settings_.knot_spacing, angle / settings_.knot_angle,
+                                    Scalar(steps) / Scalar(settings_.max_knot_steps), Scalar(1)});
+      k = std::min({static_cast<int>(std::ceil(need)), settings_.max_knots, std::max(steps, 1)});
+    }
+    knots_.clear();
+    // (a copied executor's table lost its reserve: restored here, once)
+    knots_.reserve(static_cast<std::size_t>(settings_.max_knots) << settings_.max_subdivisions);
+    knots_.push_back(Knot{Scalar(0), c0});
+    knot_positions_ = statics_.desired_state().positions;
+    max_node_rate_ = 0;
+    Vector3 tip_previous = p0.translation;
+    bool ok = true;
+    for (int i = 1; i <= k && ok; ++i) {
+      const Scalar u0 = Scalar(i - 1) / Scalar(k), u1 = Scalar(i) / Scalar(k);
+      ok = plan_interval(u0, u1, Scalar(steps), 0, tip_previous, report);
+    }
+    statics_.set_coefficients(c0);
+    // Node speed bound: stretch the timing (knot times scale with the steps).
+    Scalar node_rate = max_node_rate_;  // m per control step at `steps`
+    if (ok && steps > 0 && node_rate > max_node_step) {
+      const int stretched = static_cast<int>(std::ceil(Scalar(steps) * node_rate / max_node_step));
+      const Scalar scale = Scalar(stretched) / Scalar(steps);
+      for (Knot& knot : knots_) knot.t *= scale;
+      node_rate /= scale;
+      steps = stretched;
+      report.steps = steps;
+    }
+    report.max_node_step = node_rate;
+    if (!ok) {
+      knots_.clear();
+      knots_.push_back(Knot{Scalar(0), c0});
+      report.knots = 0;
+      return report;
+    }
+    report.accepted = true;
+    report.knots = static_cast<int>(knots_.size());
+    report.ratio = report.straight > Scalar(1e-3) ? report.tip_path / report.straight : Scalar(1);
+    target_ = goal;
+    shifted_ = goal;
+    has_target_ = true;
+    tracking_ = true;
+    knot_cursor_ = 0;
+    path_steps_ = steps;
+    ramp_steps_ = steps;
+    steps_ = 0;
+    outer_ramp_ = 0;
+    error_sum_.setZero();
+    error_count_ = 0;
+    adapt_count_ = 0;
+    last_path_ = report;
+    return report;
+  }
+
+  /// Jumps to the end of the current path or shape ramp (and of a payload ramp) without running it: the shape
+  /// target becomes the path's last knot. For planners that chain track_line() calls to check a
+  /// whole sequence before running it (on a copy of the executor).
+  void complete_path() {
+    if (tracking_) {
+      statics_.set_coefficients(knots_.back().c);
+      knots_.front() = knots_.back();
+      knots_.front().t = 0;
+      knots_.resize(1);
+      path_steps_ = 0;
+      ramp_steps_ = 0;
+      steps_ = 0;
+    } else if (has_target_ && steps_ < ramp_steps_) {
+      statics_.set_coefficients(ramp_end_);
+      ramp_steps_ = 0;
+      steps_ = 0;
+    }
+    if (payload_step_ < payload_steps_) {
+      payload_step_ = payload_steps_;
+      apply_payload(payload_to_);
+    }
+  }
+
+  /// Tells the executor the end-effector holds an object of `mass` kg whose centre of mass is at
+  /// `offset` in the end-effector frame (mass 0: nothing held). Ramped in over payload_ramp_steps.
+  void set_payload(Scalar mass, const Vector3& offset = Vector3::Zero()) {
+    if (!(mass >= 0) || !std::isfinite(mass)) manisoft::detail::fail("executor: payload mass = ", mass, " kg is invalid: it must be finite and >= 0");
+    if (!offset.allFinite()) manisoft::detail::fail("executor: payload offset (", offset.transpose(), ") is not finite");
+    payload_from_ = payload_;
+    payload_to_ = mass;
+    if (mass > 0) payload_offset_ = offset;
+    payload_step_ = 0;
+    payload_steps_ = settings_.payload_ramp_steps;
+    if (payload_steps_ == 0) apply_payload(mass);
+  }
+  Scalar payload() const { return payload_; }
+
+  /// Converged: the current path's (or ramp's) end reached, the end-effector within
+  /// converged_position / converged_rotation of the target and every observed node slower than
+  /// converged_speed (as of the last act()).
+  bool converged() const { return converged_; }
+  /// Whether an actuated element hit its limit in the last act().
+  bool saturated() const { return saturated_; }
+  /// Whether the current path (or ramp) has been run to its end.
+  bool path_done() const { return steps_ >= ramp_steps_; }
+  /// Control steps since the current path (or ramp) started.
+  long path_step() const { return steps_; }
+  const PathReport<Scalar>& last_path() const { return last_path_; }
+  /// The desired shape ((n + 1) x 3 node positions) `step` control steps into the current path
+  /// (clamped to its end); for planners that check the whole arm against obstacles. Changes
+  /// nothing; does not allocate.
+  void predicted_shape(long step, Array3& positions) {
+    positions.resize(statics_.n_elements() + 1, 3);
+    statics_.shape_positions(coefficients_at(step), positions);
   }
 
   /// Sets up a new target (inverse statics from cold starts); act() calls it when the target changes.
@@ -177,6 +403,8 @@ class ModelExecutor {
     const Scalar needed = ramp_path_ / settings_.ramp_max_speed;
     ramp_steps_ = settings_.ramp_steps == 0 ? 0 : std::clamp(static_cast<int>(std::ceil(needed)), settings_.ramp_steps, settings_.max_ramp_steps);
     statics_.set_coefficients(ramp_steps_ > 0 ? ramp_start_ : ramp_end_);
+    tracking_ = false;
+    outer_ramp_ = 0;
     return last_result_;
   }
 
@@ -187,6 +415,8 @@ class ModelExecutor {
   /// Control steps of the current target's shape ramp and the tip path length along it (m).
   int ramp_length() const { return ramp_steps_; }
   Scalar ramp_path() const { return ramp_path_; }
+  /// Outer-loop re-solves refused by the continuity check (since construction).
+  long refused_corrections() const { return refused_corrections_; }
   /// The stiffness scale the feed-forward currently assumes (1 = the model's).
   Scalar stiffness_estimate() const { return statics_.stiffness_scale(); }
 
@@ -194,6 +424,21 @@ class ModelExecutor {
   /// Stage 1: the shape target of this step: along the ramp (every intermediate shape an exact
   /// equilibrium of the model), then the outer loop's corrections.
   void advance_shape_target(const Observation<Scalar>& o) {
+    if (tracking_) {
+      if (steps_ < path_steps_) {
+        statics_.set_coefficients(coefficients_at(steps_ + 1));
+      } else if (outer_ramp_ > 0) {
+        advance_outer_ramp();
+      } else {
+        if (steps_ == path_steps_) statics_.set_coefficients(knots_.back().c);
+        outer_loop(o);
+      }
+      return;
+    }
+    if (outer_ramp_ > 0) {
+      advance_outer_ramp();
+      return;
+    }
     if (steps_ < ramp_steps_) {
       const Scalar x = Scalar(steps_ + 1) / Scalar(ramp_steps_);
       const Scalar blend = x * x * (Scalar(3) - Scalar(2) * x);
@@ -229,7 +474,7 @@ class ModelExecutor {
     Scalar tip_twist = 0;
     bool saturated = false;
     for (int k = n - 1; k >= 0; --k) {
-      distal -= node_mass_[k + 1] * (settings_.damping_gain * velocities_.row(k + 1).transpose() +
+      distal -= node_mass_[k + 1] * (settings_.damping_gain * (velocities_.row(k + 1) - desired_velocity_.row(k + 1)).transpose() +
                                      settings_.position_gain * (positions_.row(k + 1) - desired.positions.row(k + 1)).transpose());
       const Vector3 lever = (positions_.row(k + 1) - positions_.row(k)).transpose();
       // Material frame of element k estimated from the desired one, turned by the smallest
@@ -243,6 +488,9 @@ class ModelExecutor {
         tip_twist = d.allFinite() ? d.dot(lever.normalized()) : Scalar(0);
       }
       Vector3 couple = frame * lever.cross(distal);
+      // A held object's couple about the tip (its weight at the offset), cancelled on the last element.
+      if (k == n - 1 && payload_ > Scalar(0))
+        couple -= payload_ * payload_offset_.cross(Matrix3(desired.director(k)) * statics_.model().gravity);
       const Scalar share = (Scalar(k) + Scalar(0.5)) / Scalar(n);
       couple[2] -= share * (settings_.twist_gain * tip_twist + settings_.twist_damping * twist_rate);
       for (int i = 0; i < 3; ++i) {
@@ -340,13 +588,137 @@ class ModelExecutor {
     if (dp.norm() > settings_.outer_max_shift) next.translation = target_.translation + dp * (settings_.outer_max_shift / dp.norm());
     Vector3 dr = math::so3::log(next.rotation * target_.rotation.transpose());
     if (dr.norm() > settings_.outer_max_shift) next.rotation = math::so3::exp(Vector3(dr * (settings_.outer_max_shift / dr.norm()))) * target_.rotation;
-    const auto previous = statics_.coefficients();
+    const Coefficients previous = statics_.coefficients();
+    const Vector3 tip_before = statics_.desired_tip_pose().translation;
     const rod::InverseStaticsResult<Scalar> r = statics_.solve(next);
-    if (r.converged) {
-      shifted_ = next;
-    } else {
-      statics_.set_coefficients(previous);
+    const Coefficients solved = statics_.coefficients();
+    statics_.set_coefficients(previous);
+    if (!r.converged) return;
+    // Continuity: a re-solve that lands on a distant shape branch is refused; otherwise it is
+    // blended in over outer_period steps, never applied in one.
+    const Scalar straight = (next.translation - tip_before).norm();
+    if (blend_tip_path(previous, solved) > settings_.path_ratio_limit * straight + Scalar(1e-3)) {
+      ++refused_corrections_;
+      return;
     }
+    shifted_ = next;
+    outer_from_ = previous;
+    outer_to_ = solved;
+    outer_ramp_ = settings_.outer_period;
+    outer_ramp_step_ = 0;
+  }
+
+  void advance_outer_ramp() {
+    ++outer_ramp_step_;
+    const Scalar x = Scalar(outer_ramp_step_) / Scalar(outer_ramp_);
+    statics_.set_coefficients(outer_from_ + x * (outer_to_ - outer_from_));
+    if (outer_ramp_step_ >= outer_ramp_) outer_ramp_ = 0;
+  }
+
+  /// Sampled tip path of the linear coefficient blend a -> b (m); uses the solver's buffers.
+  Scalar blend_tip_path(const Coefficients& a, const Coefficients& b) {
+    constexpr int samples = 4;
+    Vector3 previous = statics_.tip_pose(a).translation;
+    Scalar path = 0;
+    for (int i = 1; i <= samples; ++i) {
+      const Vector3 p = statics_.tip_pose(Coefficients(a + (Scalar(i) / Scalar(samples)) * (b - a))).translation;
+      path += (p - previous).norm();
+      previous = p;
+    }
+    return path;
+  }
+
+  /// The path's pose at path parameter u in [0, 1] (before timing).
+  Pose path_pose(Scalar u) const {
+    Pose p;
+    p.translation = path_start_.translation + u * (path_goal_.translation - path_start_.translation);
+    p.rotation = path_start_.rotation * math::so3::exp(Vector3(u * path_rotation_));
+    return p;
+  }
+
+  static Scalar quintic(Scalar x) { return x * x * x * (Scalar(10) + x * (Scalar(-15) + Scalar(6) * x)); }
+
+  /// Plans the knots of time fraction (u0, u1] of the current path (the knot at u0 is the last
+  /// one in knots_); subdivides when the knot fails to converge within the limits or its blend
+  /// fails the continuity check. Returns false when the path must be refused.
+  bool plan_interval(Scalar u0, Scalar u1, Scalar steps, int depth, Vector3& tip_previous, PathReport<Scalar>& report) {
+    const Coefficients from = knots_.back().c;
+    const Pose pose = path_pose(quintic(u1));
+    // The smallest shape change that meets the knot (continuity); the full solver only if that fails.
+    rod::InverseStaticsResult<Scalar> r = statics_.solve_near(pose, from);
+    if (!r.within_limits) r = statics_.solve_from(pose, from);
+    const Coefficients to = statics_.coefficients();
+    bool good = r.within_limits;
+    Scalar blend_path = 0;
+    const Scalar straight = (pose.translation - tip_previous).norm();
+    if (good) {
+      blend_path = blend_tip_path(from, to);
+      good = blend_path <= settings_.path_ratio_limit * straight + Scalar(1e-3);
+    }
+    if (!good) {
+      if (depth >= settings_.max_subdivisions) {
+        report.reason = r.within_limits ? "shape branch jump: knot blend tip path exceeds path_ratio_limit x straight distance"
+                                        : "a knot of the path has no converged inverse statics solution within the actuation limits";
+        return false;
+      }
+      ++report.subdivisions;
+      const Scalar mid = Scalar(0.5) * (u0 + u1);
+      return plan_interval(u0, mid, steps, depth + 1, tip_previous, report) && plan_interval(mid, u1, steps, depth + 1, tip_previous, report);
+    }
+    if (knots_.size() == knots_.capacity()) {
+      report.reason = "knot table full";
+      return false;
+    }
+    knots_.push_back(Knot{u1 * steps, to});
+    const Array3& x = statics_.desired_state().positions;
+    const Scalar interval = (u1 - u0) * steps;
+    if (interval > Scalar(0)) max_node_rate_ = std::max(max_node_rate_, (x - knot_positions_).rowwise().norm().maxCoeff() / interval);
+    knot_positions_ = x;
+    report.tip_path += blend_path;
+    report.max_torque_ratio = std::max(report.max_torque_ratio, r.max_torque_ratio);
+    tip_previous = pose.translation;
+    return true;
+  }
+
+  /// Curvature coefficients of the current path at control step `step` (linear between knots).
+  Coefficients coefficients_at(long step) {
+    if (!tracking_) return statics_.coefficients();
+    const Scalar t = Scalar(std::clamp<long>(step, 0, path_steps_));
+    const auto last = knots_.size() - 1;
+    if (knot_cursor_ > last) knot_cursor_ = 0;
+    while (knot_cursor_ > 0 && knots_[knot_cursor_].t > t) --knot_cursor_;
+    while (knot_cursor_ + 1 < last && knots_[knot_cursor_ + 1].t < t) ++knot_cursor_;
+    if (last == 0) return knots_[0].c;
+    const Knot& a = knots_[knot_cursor_];
+    const Knot& b = knots_[knot_cursor_ + 1];
+    const Scalar span = b.t - a.t;
+    const Scalar w = span > Scalar(0) ? std::clamp((t - a.t) / span, Scalar(0), Scalar(1)) : Scalar(1);
+    return a.c + w * (b.c - a.c);
+  }
+
+  /// Desired node velocities: the finite difference of the desired shape between control steps
+  /// while a path is tracked (zero otherwise).
+  void update_desired_velocity(Scalar control_dt) {
+    const rod::RodState<Scalar>& desired = statics_.desired_state();
+    if (tracking_ && settings_.velocity_feedforward && control_dt > Scalar(0) && steps_ > 0 && steps_ <= path_steps_) {
+      desired_velocity_ = (desired.positions - previous_desired_) / control_dt;
+    } else {
+      desired_velocity_.setZero();
+    }
+    previous_desired_ = desired.positions;
+  }
+
+  void advance_payload() {
+    if (payload_step_ >= payload_steps_) return;
+    ++payload_step_;
+    const Scalar x = Scalar(payload_step_) / Scalar(payload_steps_);
+    apply_payload(payload_from_ + x * (payload_to_ - payload_from_));
+  }
+
+  void apply_payload(Scalar mass) {
+    payload_ = mass;
+    statics_.set_model_estimates(statics_.stiffness_scale(), statics_.model().payload_mass + mass);
+    node_mass_[statics_.n_elements()] = tip_node_mass_ + mass;
   }
 
   rod::InverseStatics<Scalar> statics_;
@@ -362,6 +734,28 @@ class ModelExecutor {
   long steps_ = 0;
   Array3 positions_, velocities_;
   Eigen::Matrix<Scalar, Eigen::Dynamic, 1> node_mass_;
+  struct Knot {
+    Scalar t;  ///< control steps from the path's start (fractional after subdivision)
+    Coefficients c;
+  };
+  std::vector<Knot> knots_;
+  Array3 knot_positions_;
+  Scalar max_node_rate_ = 0;
+  std::size_t knot_cursor_ = 0;
+  bool tracking_ = false;
+  long path_steps_ = 0;
+  Pose path_start_, path_goal_;
+  Vector3 path_rotation_ = Vector3::Zero();
+  PathReport<Scalar> last_path_;
+  Array3 desired_velocity_, previous_desired_;
+  Coefficients outer_from_ = Coefficients::Zero(), outer_to_ = Coefficients::Zero();
+  int outer_ramp_ = 0, outer_ramp_step_ = 0;
+  long refused_corrections_ = 0;
+  Scalar payload_ = 0, payload_from_ = 0, payload_to_ = 0;
+  Vector3 payload_offset_ = Vector3::Zero();
+  int payload_step_ = 0, payload_steps_ = 0;
+  Scalar tip_node_mass_ = 0;
+  bool converged_ = false, saturated_ = false;
   Eigen::Matrix<Scalar, 6, 1> error_sum_ = Eigen::Matrix<Scalar, 6, 1>::Zero();
   int error_count_ = 0;
   Matrix3 previous_rotation_ = Matrix3::Identity();

@@ -48,6 +48,7 @@
 #include <string>
 
 #include "manisoft/control/action_space.hpp"
+#include "manisoft/control/arm_observation.hpp"
 #include "manisoft/control/executor.hpp"
 #include "manisoft/core/error.hpp"
 #include "manisoft/reward/distance_reward.hpp"
@@ -136,15 +137,7 @@ class ReachEnv {
     if (config_.hold_steps < 1) manisoft::detail::fail("hold_steps = ", config_.hold_steps, " must be >= 1");
     if (config_.stability_window < 1) manisoft::detail::fail("stability_window = ", config_.stability_window, " must be >= 1");
     const int n = config_.rod.n_elements;
-    int count = 0;
-    for (int j = 0; j <= n; j += config_.observe_stride) ++count;
-    const bool tip_missing = (n % config_.observe_stride) != 0;
-    observation_.node_indices.resize(count + (tip_missing ? 1 : 0));
-    int i = 0;
-    for (int j = 0; j <= n; j += config_.observe_stride) observation_.node_indices[i++] = j;
-    if (tip_missing) observation_.node_indices[i] = n;
-    observation_.node_positions.setZero(observation_.node_indices.size(), 3);
-    observation_.node_velocities.setZero(observation_.node_indices.size(), 3);
+    observation_ = control::make_arm_observation<double>(n, config_.observe_stride);
     d_history_.setZero(config_.stability_window);
     element_torques_.setZero(n, 3);
   }
@@ -298,16 +291,7 @@ class ReachEnv {
     ++d_count_;
   }
 
-  void fill_observation() {
-    const auto& s = world_->rod().state();
-    observation_.target = target_;
-    observation_.end_effector = end_effector();
-    observation_.time = s.time;
-    for (Eigen::Index i = 0; i < observation_.node_indices.size(); ++i) {
-      observation_.node_positions.row(i) = s.positions.row(observation_.node_indices[i]);
-      observation_.node_velocities.row(i) = s.velocities.row(observation_.node_indices[i]);
-    }
-  }
+  void fill_observation() { control::observe_arm(*world_, target_, observation_); }
 
   ReachEnvConfig config_;
   Damping<double> damping_;

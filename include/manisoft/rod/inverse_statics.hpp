@@ -186,6 +186,14 @@ class InverseStatics {
     return Pose{directors_[n_elements() - 1].transpose(), tip_};
   }
 
+  /// Forward statics: node positions ((n + 1) x 3, lab) of the shape with coefficients c (does
+  /// not change the committed solution; `positions` must have n + 1 rows). Does not allocate.
+  void shape_positions(const Coefficients& c, Array3& positions) {
+    if (positions.rows() != n_elements() + 1) manisoft::detail::fail("InverseStatics::shape_positions: positions has ", positions.rows(), " rows, expected ", n_elements() + 1);
+    shape(c);
+    for (int k = 0; k <= n_elements(); ++k) positions.row(k) = positions_cache_[k].transpose();
+  }
+
   /// Solves for `target` starting from the last solution (warm start). Does not allocate.
   InverseStaticsResult<Scalar> solve(const Pose& target) { return solve_from(target, coefficients_); }
 
@@ -288,6 +296,23 @@ class InverseStatics {
     return solve_impl(target, start, settings_.max_iterations);
   }
 
+  /// Solves for a target near the shape `start` by minimum-effort-norm Gauss-Newton steps only
+  /// (stage 3 below, at most `max_iterations`): the smallest change of the shape (in the effort
+  /// norm W) that meets the target, so a path of nearby targets gives a continuous shape
+  /// sequence. No LM, no polish: ~4 iterations for a 1 cm step. The result becomes the committed
+  /// solution; when it has not converged the caller can fall back to solve_from. Does not allocate.
+  InverseStaticsResult<Scalar> solve_near(const Pose& target, const Coefficients& start, int max_iterations = 8) {
+    require_finite_target(target);
+    if (!start.allFinite()) manisoft::detail::fail("InverseStatics: the start coefficients are not finite");
+    Coefficients c = start;
+    Residual r = residual(c, target);
+    const int it = newton(target, c, r, max_iterations, true);
+    shape(c);
+    coefficients_ = c;
+    commit();
+    return make_result(r, it, 0);
+  }
+
  private:
   InverseStaticsResult<Scalar> solve_impl(const Pose& target, const Coefficients& start, int max_iterations) {
     require_finite_target(target);
@@ -298,10 +323,14 @@ class InverseStatics {
     int it = lm_it;
     // A start whose LM did not get near a solution is not worth polishing (solve_cold moves on).
     if (r.norm() < settings_.polish_threshold) it += polish(target, c, r);
-    it += newton(target, c, r);
+    it += newton(target, c, r, 3);
     shape(c);
     coefficients_ = c;
     commit();
+    return make_result(r, it, lm_it);
+  }
+
+  InverseStaticsResult<Scalar> make_result(const Residual& r, int it, int lm_it) const {
     InverseStaticsResult<Scalar> result;
     result.position_error = r.template head<3>().norm();
     result.rotation_error = r.template tail<3>().norm() / settings_.rotation_weight;
@@ -381,14 +410,20 @@ class InverseStatics {
 
   /// Stage 3: final Newton steps (minimum-W-norm step) so the shape meets the target to
   /// round-off; returns its iterations.
-  int newton(const Pose& target, Coefficients& c, Residual& r) {
+  int newton(const Pose& target, Coefficients& c, Residual& r, int max_iterations, bool halving = false) {
     int p = 0;
-    for (; p < 3 && r.norm() > settings_.tolerance; ++p) {
+    for (; p < max_iterations && r.norm() > settings_.tolerance; ++p) {
       jacobian(c, r, target);
       const Eigen::Matrix<Scalar, n_coefficients, 6> wj = regularizer_inverse_ * jacobian_.transpose();
       const Eigen::Matrix<Scalar, 6, 6> m = jacobian_ * wj;
-      const Coefficients trial = c - wj * m.ldlt().solve(r);
-      const Residual r_trial = residual(trial, target);
+      const Coefficients step = wj * m.ldlt().solve(r);
+      Coefficients trial = c - step;
+      Residual r_trial = residual(trial, target);
+      // Far from the solution a full step can overshoot: halve it while it does not help.
+      for (int half = 0; halving && half < 4 && !(r_trial.norm() < r.norm()); ++half) {
+        trial = c - std::ldexp(Scalar(1), -(half + 1)) * step;
+        r_trial = residual(trial, target);
+      }
       if (!(r_trial.norm() < r.norm())) break;
       c = trial;
       r = r_trial;

@@ -1,0 +1,91 @@
+// pick_place_eval: the model executor as a trajectory tracker on a tabletop pick and place
+// (issue 10; the routine is env::PickPlaceRunner, include/manisoft/env/pick_place.hpp).
+//
+//   pick_place_eval --episodes N --seed S [--mass KG] --out FILE.csv
+//
+// Episode i uses seed S * 100000 + i. Prints one table row per episode as it goes, then a last
+// line of JSON:
+//   {"episodes":N, "success_rate":..., "mean_steps":..., "max_steps":..., "mean_cpu_s":...,
+//    "max_node_speed":..., "max_path_ratio":..., "failures":{"reason":count,...}}
+// (steps over all episodes, successful or not; speeds in m/s; path ratio: measured end-effector
+// path over the straight distance, worst segment of any episode). The CSV has one row per episode.
+// Exit codes: 0 done, 1 refused configuration or failed run, 2 bad flags (CLI11).
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <string>
+
+#include "manisoft/env/pick_place.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"pick_place_eval: tabletop pick and place with the model executor as a trajectory tracker"};
+  int episodes = 20;
+  long seed = 1;
+  double mass = 0.1;
+  std::string out;
+  app.add_option("--episodes", episodes, "episodes to run")->required()->check(CLI::Range(1, 1000000));
+  app.add_option("--seed", seed, "seed of the task set (episode i: seed * 100000 + i)")->required()->check(CLI::Range(0L, 1000000000L));
+  app.add_option("--mass", mass, "cube mass, kg (default 0.1)")->check(CLI::Range(0.001, 5.0));
+  app.add_option("--out", out, "per-episode CSV")->required();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    std::ofstream csv(out);
+    if (!csv) manisoft::detail::fail("pick_place_eval: cannot write '", out, "'");
+    csv << "episode,seed,success,failure,steps,cpu_s,executor_s,max_setup_s,max_node_speed,max_path_ratio,max_planned_ratio,"
+           "place_error,tilt,grasp_step,release_step,cube_x,cube_y,cube_yaw,place_x,place_y\n";
+    csv.precision(9);
+    manisoft::env::PickPlaceConfig config;
+    config.cube_mass = mass;
+    manisoft::env::PickPlaceRunner runner(config);
+    std::printf("pick and place: %d episodes, seed %ld, cube %.3f kg (home reset: %d control steps, not counted)\n", episodes, seed, mass,
+                runner.home_steps());
+    std::printf("%7s %8s %-13s %6s %7s %9s %8s %8s %9s\n", "episode", "success", "failure", "steps", "cpu_s", "node_m/s", "path_ratio",
+                "err_mm", "setup_ms");
+    int successes = 0, max_steps = 0;
+    long total_steps = 0;
+    double total_cpu = 0, max_speed = 0, max_ratio = 0, executor_s = 0, max_setup = 0;
+    std::map<std::string, int> failures;
+    for (int i = 0; i < episodes; ++i) {
+      const std::uint64_t s = std::uint64_t(seed) * 100000u + std::uint64_t(i);
+      const manisoft::env::PickPlaceResult r = runner.run(s);
+      successes += r.success;
+      total_steps += r.steps;
+      max_steps = std::max(max_steps, r.steps);
+      total_cpu += r.cpu_seconds;
+      executor_s += r.executor_seconds;
+      max_setup = std::max(max_setup, r.max_setup_seconds);
+      max_speed = std::max(max_speed, r.max_node_speed);
+      max_ratio = std::max(max_ratio, r.max_path_ratio);
+      if (!r.success) ++failures[r.failure];
+      std::printf("%7d %8s %-13s %6d %7.3f %9.3f %10.3f %8.1f %9.3f\n", i, r.success ? "yes" : "no", r.success ? "-" : r.failure.c_str(),
+                  r.steps, r.cpu_seconds, r.max_node_speed, r.max_path_ratio, 1e3 * r.place_error, 1e3 * r.max_setup_seconds);
+      std::fflush(stdout);
+      csv << i << ',' << s << ',' << int(r.success) << ',' << (r.success ? "" : r.failure) << ',' << r.steps << ',' << r.cpu_seconds << ','
+          << r.executor_seconds << ',' << r.max_setup_seconds << ',' << r.max_node_speed << ',' << r.max_path_ratio << ','
+          << r.max_planned_ratio << ',' << r.place_error << ',' << r.tilt << ',' << r.grasp_step << ',' << r.release_step << ','
+          << r.task.cube.x() << ',' << r.task.cube.y() << ',' << r.task.cube_yaw << ',' << r.task.place.x() << ',' << r.task.place.y()
+          << '\n';
+    }
+    if (!csv.flush()) manisoft::detail::fail("pick_place_eval: writing '", out, "' failed");
+    std::printf("executor: %.2f us per control step on average (CPU, path set-ups included), slowest path set-up %.3f ms\n",
+                1e6 * executor_s / double(std::max(1L, total_steps)), 1e3 * max_setup);
+    std::printf("{\"episodes\":%d, \"success_rate\":%.4f, \"mean_steps\":%.1f, \"max_steps\":%d, \"mean_cpu_s\":%.4f, \"max_node_speed\":%.4f, "
+                "\"max_path_ratio\":%.4f, \"failures\":{",
+                episodes, double(successes) / episodes, double(total_steps) / episodes, max_steps, total_cpu / episodes, max_speed, max_ratio);
+    bool first = true;
+    for (const auto& [reason, count] : failures) {
+      std::printf("%s\"%s\":%d", first ? "" : ", ", reason.c_str(), count);
+      first = false;
+    }
+    std::printf("}}\n");
+  } catch (const std::exception& e) {
+    std::cerr << "pick_place_eval: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,185 @@
+// The model executor as a trajectory tracker (issue 10): shape continuity on the yaw-90 and
+// yaw-180 tool-down cases, refusal of a path that cannot be held, a moving-target tracking error
+// bound, payload compensation, and the pick-and-place routine (success, step and speed bounds,
+// determinism).
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "manisoft/control/arm_observation.hpp"
+#include "manisoft/control/model_executor.hpp"
+#include "manisoft/env/pick_place.hpp"
+#include "manisoft/env/reach_env.hpp"
+#include "manisoft/world/tabletop_scene.hpp"
+
+namespace {
+
+namespace control = manisoft::control;
+using Pose = manisoft::math::Pose<double>;
+using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+using Env = manisoft::env::ReachEnv<manisoft::rod::damping::AnalyticalLinear>;
+
+/// The gripper pointing straight down with yaw `yaw` at attachment point p (world frame).
+Pose tool_down(const Eigen::Vector3d& p, double yaw) {
+  Eigen::Matrix3d down;
+  down << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+  return Pose{Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * down, p};
+}
+
+manisoft::rod::ArmModel<double> tabletop_model() {
+  return manisoft::rod::make_arm_model(manisoft::world::tabletop_arm_parameters(), 0.2);
+}
+
+/// Runs `steps` control steps of env with the executor, the observation's target replaced by
+/// `target`; calls check(step, observation) after each.
+template <typename Check>
+void drive(Env& env, control::ModelExecutor<double>& executor, const Pose& target, int steps, Check&& check) {
+  control::Observation<double> o = control::make_arm_observation<double>(env.n_elements(), env.config().observe_stride);
+  Array3 action = Array3::Zero(env.n_elements(), 3);
+  for (int i = 0; i < steps; ++i) {
+    control::observe_arm(env.world(), target, o);
+    executor.act(o, action);
+    env.step(action);
+    control::observe_arm(env.world(), target, o);
+    check(i, o);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("a 4 cm move keeps the shape branch at gripper yaws of 90 and 180 degrees", "[executor][tracking]") {
+  // DESIGN.md section 10: a cold re-solve for a nearby target jumped to a distant branch (a 3.3-3.5 m
+  // tip path for a 4 cm move), mostly at these yaws. The tracked path's shapes, sampled here through
+  // predicted_shape (independently of the planner's own check), move the tip along a path at most
+  // 1.5 x the straight distance and no node by more than a few cm between samples.
+  for (double yaw_deg : {90.0, 180.0}) {
+    for (const Eigen::Vector3d& move : {Eigen::Vector3d(0.04, 0, 0), Eigen::Vector3d(0, 0.04, 0), Eigen::Vector3d(0, 0, -0.04)}) {
+      control::ModelExecutor<double> executor(tabletop_model(), {150, 75});
+      const Pose start = tool_down({0.5, 0.05, 0.93}, yaw_deg * std::numbers::pi / 180);
+      REQUIRE(executor.set_target(start).within_limits);
+      executor.complete_path();
+      Pose goal = start;
+      goal.translation += move;
+      const auto report = executor.track_line(goal, 120);
+      CAPTURE(yaw_deg, move.transpose(), report.reason);
+      REQUIRE(report.accepted);
+      CHECK(report.ratio <= 1.5);
+      Array3 shape, previous;
+      executor.predicted_shape(0, previous);
+      CHECK((previous.row(previous.rows() - 1).transpose() - start.translation).norm() < 1e-6);
+      double tip_path = 0, worst_node_step = 0;
+      for (int step = 5; step <= 120; step += 5) {
+        executor.predicted_shape(step, shape);
+        tip_path += (shape.row(shape.rows() - 1) - previous.row(previous.rows() - 1)).norm();
+        worst_node_step = std::max(worst_node_step, (shape - previous).rowwise().norm().maxCoeff());
+        previous = shape;
+      }
+      CAPTURE(tip_path, worst_node_step);
+      CHECK((previous.row(previous.rows() - 1).transpose() - goal.translation).norm() < 1e-6);
+      CHECK(tip_path <= 1.5 * 0.04);
+      CHECK(worst_node_step < 0.03);
+    }
+  }
+}
+
+TEST_CASE("a path the arm cannot hold is refused and leaves the executor as it was", "[executor][tracking]") {
+  control::ModelExecutor<double> executor(tabletop_model(), {150, 75});
+  const Pose start = tool_down({0.5, 0.0, 0.93}, 0.0);
+  REQUIRE(executor.set_target(start).within_limits);
+  executor.complete_path();
+  const auto before = executor.statics().coefficients();
+  // 0.6 m below the table and far out: beyond the 1 m arm held within the limits.
+  const auto report = executor.track_line(tool_down({1.3, 0.0, 0.3}, 0.0), 200);
+  CHECK_FALSE(report.accepted);
+  CHECK(std::string(report.reason).size() > 0);
+  CHECK(executor.statics().coefficients() == before);
+  // A path of length zero is a point target.
+  const auto hold = executor.track_line(start, 0);
+  CHECK(hold.accepted);
+  CHECK(hold.knots == 2);
+  CHECK_THROWS_WITH(executor.track_line(start, -1), Catch::Contains("-1"));
+}
+
+TEST_CASE("the tracker follows a moving target within a bound and converges at its end", "[executor][tracking]") {
+  Env env({}, manisoft::rod::damping::AnalyticalLinear<double>(0.1));
+  env.reset(1);
+  control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits);
+  const Pose start = tool_down({0.5, 0.0, 0.93}, 0.3);
+  REQUIRE(executor.set_target(start).within_limits);
+  drive(env, executor, start, 700, [](int, const control::Observation<double>&) {});
+  REQUIRE(executor.converged());
+  // 15 cm sideways and 5 cm down in 250 control steps (0.35 s, peak 0.85 m/s at the tip).
+  Pose goal = start;
+  goal.translation += Eigen::Vector3d(0.0, 0.15, -0.05);
+  const auto report = executor.track_line(goal, 250);
+  REQUIRE(report.accepted);
+  double worst = 0, node_speed = 0;
+  bool converged_early = false;
+  drive(env, executor, goal, 450, [&](int i, const control::Observation<double>& o) {
+    // The error to the moving reference (the shape target's tip pose at this step).
+    worst = std::max(worst, (o.end_effector.translation - executor.statics().desired_tip_pose().translation).norm());
+    node_speed = std::max(node_speed, o.node_velocities.rowwise().norm().maxCoeff());
+    if (i < 240 && executor.converged()) converged_early = true;
+  });
+  CAPTURE(worst, node_speed);
+  CHECK(worst < 0.03);
+  CHECK(node_speed < 1.5);
+  CHECK_FALSE(converged_early);
+  const Pose end = env.world().soft().end_effector_frame().position.allFinite() ? Pose{env.world().soft().end_effector_frame().rotation, env.world().soft().end_effector_frame().position} : Pose{};
+  CHECK((end.translation - goal.translation).norm() < 0.01);
+}
+
+TEST_CASE("the payload hint removes a held object's sag", "[executor][tracking]") {
+  // The reach arm holding 0.1 kg more than its model (in the gripper), estimators and outer loop
+  // off so only the feed-forward and the node feedback act. The hint set_payload(0.1) puts the
+  // pose within 1 mm of the unloaded arm's and cuts the sag left without it (measured here: 0.23
+  // mm without, 0.06 mm with the hint at the default gains; the position feedback, kp = 800 1/s^2,
+  // already holds most of the 8 mm DESIGN.md section 10 saw with its gains).
+  const Pose target = tool_down({0.5, 0.05, 0.95}, 0.0);
+  control::ModelExecutorSettings<double> settings;
+  settings.outer_gain = 0;
+  settings.stiffness_gain = 0;
+  auto final_position = [&](double load, double hint) {
+    manisoft::env::ReachEnvConfig config;
+    config.load_mass = load;
+    Env env(config, manisoft::rod::damping::AnalyticalLinear<double>(0.1));
+    env.reset(1);
+    control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits, settings);
+    executor.set_target(target);
+    executor.set_payload(hint);
+    drive(env, executor, target, 900, [](int, const control::Observation<double>&) {});
+    return Eigen::Vector3d(env.world().soft().end_effector_frame().position);
+  };
+  const Eigen::Vector3d unloaded = final_position(0, 0), sagging = final_position(0.1, 0), compensated = final_position(0.1, 0.1);
+  CAPTURE(unloaded.transpose(), sagging.transpose(), compensated.transpose());
+  CHECK((compensated - unloaded).norm() < 0.001);
+  CHECK((sagging - unloaded).norm() > 2 * (compensated - unloaded).norm());
+  CHECK((sagging - unloaded).z() < 0);  // it sags down
+  control::ModelExecutor<double> executor(tabletop_model(), {150, 75});
+  CHECK_THROWS_WITH(executor.set_payload(-0.1), Catch::Contains("-0.1"));
+}
+
+TEST_CASE("pick and place: a few episodes succeed within the step and speed bounds, deterministically", "[executor][pick_place]") {
+  manisoft::env::PickPlaceRunner a, b;
+  for (std::uint64_t seed : {100000u, 100001u, 100002u}) {
+    const auto r = a.run(seed);
+    CAPTURE(seed, r.failure, r.detail, r.steps, r.max_node_speed, r.max_path_ratio, r.place_error);
+    CHECK(r.success);
+    CHECK(r.steps <= 1500);
+    CHECK(r.max_node_speed < 1.5);
+    CHECK(r.max_path_ratio <= 1.5);
+    CHECK(r.place_error < 0.02);
+    CHECK(r.grasp_step > 0);
+    CHECK(r.release_step > r.grasp_step);
+    // The same seed in another runner (and after other episodes) gives the same episode, bit for bit.
+    const auto again = b.run(seed);
+    CHECK(again.steps == r.steps);
+    CHECK(again.place_error == r.place_error);
+    CHECK(again.max_node_speed == r.max_node_speed);
+  }
+  manisoft::env::PickPlaceConfig bad;
+  bad.cube_mass = -1;
+  CHECK_THROWS_WITH(manisoft::env::PickPlaceRunner(bad), Catch::Contains("cube_mass"));
+}
