@@ -131,7 +131,7 @@ class SceneSampler {
       case Task::arr: ok = draw_arr(s, d); break;
     }
     if (!ok) return std::nullopt;
-    if (rnd) add_obstacles(s, d);
+    if (rnd && !add_obstacles(s, d)) return std::nullopt;
     return s;
   }
 
@@ -220,7 +220,8 @@ class SceneSampler {
     s.lighting.ambient_intensity = d.uniform(0.25, 0.45);
   }
 
-  void add_obstacles(SceneSpec& s, Draw& d) {
+  /// Places 3-10 obstacles; false when fewer than the drawn count found room.
+  bool add_obstacles(SceneSpec& s, Draw& d) {
     const int n = d.integer(settings_.min_obstacles, settings_.max_obstacles);
     const auto& all = library_.obstacles();
     const double top = s.table.top_center.z();
@@ -240,6 +241,7 @@ class SceneSampler {
         break;
       }
     }
+    return static_cast<int>(s.obstacles.size()) == n;
   }
 
   bool draw_coll(SceneSpec& s, Draw& d) {
