@@ -1,8 +1,8 @@
 // scene_reach_map: measures where the arm reaches the table top tool-down (scene/reach_map.hpp:
 // one inverse-statics solve within the actuation limits per cell, height and yaw, the rod clear
 // of the top), prints the maps and the covered fractions, and writes a PGM picture: per cell the
-// number of grasp heights reached (black none, white all), with the samplers' ReachBand at the
-// lowest height outlined in grey.
+// number of grasp heights reached (black none, white all), with the samplers' area (ReachBand)
+// at the lowest height outlined (black on reachable cells, white elsewhere).
 //   scene_reach_map [--cell 0.025] [--heights 0.08,0.15,0.22,0.30] [--out reach.pgm] [--scale 8]
 #include <CLI/CLI.hpp>
 
@@ -76,10 +76,11 @@ int main(int argc, char** argv) {
         int c = 0;
         for (const auto& m : maps) c += m.cell_reachable(ix, iy);
         int v = c * 255 / static_cast<int>(maps.size());
-        // the band at the lowest height: outline where the pixel's inside/outside changes
-        const double x = m0.x0 + (m0.nx * scale - row - 0.5) * cell / scale, y = m0.y0 + (col + 0.5) * cell / scale;
-        const double r = (Eigen::Vector2d(x, y) - band.center).norm(), px = cell / scale;
-        if (std::abs(r - band.r_in(heights.front())) < px || std::abs(r - band.r_out(heights.front())) < px) v = 128;
+        // the samplers' area (ReachBand) at the lowest height: outlined where it begins or ends
+        const double px = cell / scale;
+        const double x = m0.x0 + (m0.nx * scale - row - 0.5) * px, y = m0.y0 + (col + 0.5) * px;
+        const bool in = band.contains({x, y}, heights.front());
+        if (in != band.contains({x - px, y}, heights.front()) || in != band.contains({x, y + px}, heights.front())) v = v >= 128 ? 0 : 255;
         img.put(static_cast<char>(v));
       }
     }

@@ -54,11 +54,12 @@ struct Stats {
   double seconds = 0;
 };
 
-/// 10 cm cells of the table whose centre lies in the band at grasp height 0.12 m.
+/// 10 cm cells of the table whose centre lies in the band at grasp height 0.12 m (not the edge
+/// cells: a graspable object's centre keeps 10 cm from the edges).
 std::set<std::pair<int, int>> band_cells(const ReachBand& band) {
   std::set<std::pair<int, int>> out;
-  for (int ix = 0; ix < 8; ++ix)
-    for (int iy = 0; iy < 10; ++iy)
+  for (int ix = 1; ix < 7; ++ix)
+    for (int iy = 1; iy < 9; ++iy)
       if (band.contains(Eigen::Vector2d(0.05 + 0.1 * ix, -0.45 + 0.1 * iy), 0.12)) out.insert({ix, iy});
   return out;
 }
@@ -184,7 +185,7 @@ void check_scene(const SceneSpec& s, const AssetLibrary& lib, Stats& st) {
   ++st.scenes;
 }
 
-void run(int per_cell, bool report, const std::vector<Task>& tasks) {
+void run(int per_cell, bool report, const std::vector<Task>& tasks, bool kinds = true) {
   SceneSampler sampler;
   std::map<std::pair<Task, Setting>, Stats> all;
   for (Task t : tasks)
@@ -219,7 +220,7 @@ void run(int per_cell, bool report, const std::vector<Task>& tasks) {
     for (auto& [c, n] : st.stack_sizes) sizes[c] += n;
     hit.insert(st.band_cells_hit.begin(), st.band_cells_hit.end());
   }
-  auto has = [&](Task t) { return std::find(tasks.begin(), tasks.end(), t) != tasks.end(); };
+  auto has = [&](Task t) { return kinds && std::find(tasks.begin(), tasks.end(), t) != tasks.end(); };
   if (has(Task::coll)) {
     for (const auto& c : coll_categories()) {
       INFO("COLL category " << c);
@@ -255,8 +256,8 @@ TEST_CASE("COLL: 60 clean + 60 randomized scenes valid, all 13 categories and bo
 TEST_CASE("ALN: 30 clean + 30 randomized scenes valid, every category appears", "[scene]") { run(30, false, {Task::aln}); }
 TEST_CASE("STK: 30 clean + 30 randomized scenes valid, both categories and 2, 3, 4 items appear", "[scene]") { run(30, false, {Task::stk}); }
 TEST_CASE("ARR: 40 clean + 40 randomized scenes valid, every category and relation kind appears", "[scene]") { run(40, false, {Task::arr}); }
-TEST_CASE("clean placements cover the reachable band (20 scenes per task and setting)", "[scene]") {
-  run(20, false, {Task::coll, Task::aln, Task::stk, Task::arr});
+TEST_CASE("clean placements cover the reachable band (15 scenes per task and setting)", "[scene]") {
+  run(15, false, {Task::coll, Task::aln, Task::stk, Task::arr}, false);
 }
 
 TEST_CASE("1,000 sampled scenes per task and setting are valid (slow)", "[.][slow]") { run(1000, true, {Task::coll, Task::aln, Task::stk, Task::arr}); }

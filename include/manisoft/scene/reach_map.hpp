@@ -56,23 +56,29 @@ inline bool pose_reachable(rod::InverseStatics<double>& statics, const math::Pos
   return true;
 }
 
-/// Where samplers place things: the band around the arm's base in which tool-down poses at
-/// height h (gripper frame above the table top) are reachable, an annulus of radii
-/// r_in(h) = inner + inner_slope h and r_out(h) = outer + outer_slope h about the base's
-/// horizontal position, shrunk by `margin`. The coefficients are design parameters read off the
-/// measured maps (measure_reach_map; README "Scenes" has the picture); every sampled pose is
-/// still checked with the inverse statics before a scene is returned.
+/// Where samplers place things: the measured reachable area (measure_reach_map; README "Scenes"
+/// has the picture) as two simple shapes, both shrunk by `margin`:
+///  - the band in front of the base in which tool-down poses at height h (gripper frame above the
+///    table top) are reachable, an annulus of radii r_in(h) = inner + inner_slope h and
+///    r_out(h) = outer + outer_slope h about the base's horizontal position;
+///  - the two back corners of the table beside the base (x <= corner_x_max, |y| >= corner_y_min),
+///    reached with the gripper turned a quarter turn.
+/// The coefficients are design parameters read off the measured maps; every sampled pose is still
+/// checked with the inverse statics before a scene is returned.
 struct ReachBand {
   Eigen::Vector2d center = world::ArmMount{}.base_position.head<2>();
   double inner = 0.40, inner_slope = 0.43;
   double outer = 0.60, outer_slope = 0.53;
+  double corner_x_max = 0.325, corner_y_min = 0.275;
   double margin = 0.02;
   double r_in(double h) const { return inner + inner_slope * h + margin; }
   double r_out(double h) const { return outer + outer_slope * h - margin; }
-  bool contains(const Eigen::Vector2d& p, double h) const {
+  bool in_annulus(const Eigen::Vector2d& p, double h) const {
     const double r = (p - center).norm();
-    return r >= r_in(h) && r <= r_out(h);
+    return p.x() > center.x() && r >= r_in(h) && r <= r_out(h);
   }
+  bool in_corners(const Eigen::Vector2d& p) const { return p.x() <= corner_x_max - margin && std::abs(p.y()) >= corner_y_min + margin; }
+  bool contains(const Eigen::Vector2d& p, double h) const { return in_annulus(p, h) || in_corners(p); }
 };
 
 struct ReachMapSettings {

@@ -6,7 +6,7 @@
 //  ARR   2-3 objects of Rubik's cube / bottle / pen cup / shoe + one relation (left_of, right_of,
 //        in_front_of, behind, next_to with 2; between, in_a_row with 3) and a free spot for it.
 // clean: only the task's objects, canonical appearance and lighting, upright at yaw 0, positions
-// uniform over the reachable band (ReachBand at each object's grasp height), so they spread
+// uniform over the reachable area (ReachBand at each object's grasp height), so they spread
 // evenly over the reachable table area; randomized: also 3-10 obstacles anywhere on the table,
 // random yaws, table texture and colours, lighting intensity, colour and direction, object colours.
 // Footprints (circles around the bounding boxes; graspable objects keep the gripper's palm free
@@ -65,6 +65,7 @@ struct SamplerSettings {
   double table_margin = 0.02;       ///< m from the table edges
   double min_goal_distance = 0.12;  ///< m: an ALN goal / ARR spot this far from the start at least
   double relation_distance = 0.15;  ///< m between an ARR object and its reference
+  double fit_clearance = 0.004;     ///< m: a COLL object is this much narrower than the opening
   int min_obstacles = 3, max_obstacles = 10;
   ReachBand band;
   ValidationSettings validation;
@@ -158,17 +159,14 @@ class SceneSampler {
       if (static_cast<int>(i) != ignore && (discs_[i].c - p).norm() < discs_[i].r + r + settings_.gap) return false;
     return true;
   }
-  /// A free point of the reachable band at grasp height h for a footprint of radius r.
+  /// A free point of the reachable area (ReachBand) at grasp height h for a footprint of radius
+  /// r: uniform over the table, kept when inside the band (rejection sampling).
   std::optional<Eigen::Vector2d> reachable_spot(const SceneSpec& s, Draw& d, double h, double r) {
     const auto& b = settings_.band;
-    const double r0 = b.r_in(h), r1 = b.r_out(h);
-    if (!(r1 > r0)) return std::nullopt;
+    const Eigen::Vector2d c = s.table.top_center.head<2>();
     for (int t = 0; t < settings_.placement_tries; ++t) {
-      // uniform over the annulus: radius with density ~ r, angle over the half plane in front
-      const double rr = std::sqrt(d.uniform(r0 * r0, r1 * r1));
-      const double ang = d.uniform(-0.5 * 3.14159265358979323846, 0.5 * 3.14159265358979323846);
-      const Eigen::Vector2d p = b.center + rr * Eigen::Vector2d(std::cos(ang), std::sin(ang));
-      if (on_table(s, p, r) && free(p, r)) return p;
+      const Eigen::Vector2d p(d.uniform(c.x() - s.table.half_x, c.x() + s.table.half_x), d.uniform(c.y() - s.table.half_y, c.y() + s.table.half_y));
+      if (b.contains(p, h) && on_table(s, p, r) && free(p, r)) return p;
     }
     return std::nullopt;
   }
@@ -244,9 +242,40 @@ class SceneSampler {
     return static_cast<int>(s.obstacles.size()) == n;
   }
 
+  /// Whether `obj` fits through the opening of `container` (round: its footprint circle; square:
+  /// its larger side) with `fit_clearance` to spare.
+  bool fits(const assets::Asset& obj, const assets::Asset& container) const {
+    if (container.receptacles.empty()) return false;
+    const auto& r = container.receptacles.front();
+    if (r.inner_radius > 0) return 2 * footprint_radius(obj) <= 2 * r.inner_radius - settings_.fit_clearance;
+    return 2 * std::max(obj.bounding_half_extents.x(), obj.bounding_half_extents.y()) <= 2 * r.inner_half_extents.minCoeff() - settings_.fit_clearance;
+  }
+
   bool draw_coll(SceneSpec& s, Draw& d) {
-    const assets::Asset& obj = pick_instance(d, d.pick(coll_categories()));
-    const assets::Asset& box = pick_instance(d, d.pick(coll_containers()));
+    // the category uniformly; within it an instance that fits some container (all instances when
+    // none does: the catalogue's containers are at most 8.5 cm wide)
+    const auto instances = library_.category(d.pick(coll_categories()));
+    std::vector<const assets::Asset*> containers;
+    for (const auto& c : coll_containers())
+      for (const auto* a : library_.category(c)) containers.push_back(a);
+    std::vector<const assets::Asset*> fitting;
+    for (const auto* o : instances)
+      for (const auto* c : containers)
+        if (fits(*o, *c)) {
+          fitting.push_back(o);
+          break;
+        }
+    const assets::Asset& obj = *d.pick(fitting.empty() ? instances : fitting);
+    std::vector<const assets::Asset*> hosts;
+    for (const auto* c : containers)
+      if (fits(obj, *c)) hosts.push_back(c);
+    if (hosts.empty()) {  // the widest opening
+      const assets::Asset* widest = containers.front();
+      for (const auto* c : containers)
+        if (c->bounding_half_extents.x() > widest->bounding_half_extents.x()) widest = c;
+      hosts.push_back(widest);
+    }
+    const assets::Asset& box = *d.pick(hosts);
     const double place_h = asset_height(box) + grasp_height(obj) + settings_.validation.place_clearance;
     const int c = place_object(s, d, box, place_h, false);
     if (c < 0) return false;
