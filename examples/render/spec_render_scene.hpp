@@ -1,6 +1,6 @@
 // A render::SceneDescription of a scene::SceneSpec (render_scene --scene): floor, the spec's
-// table (size, texture, colours), the arm mount, the soft arm in the built-in picture's pose with
-// its gripper, every object and obstacle drawn from its asset's visual parts (the spec's colour
+// table (size, texture, colours), the arm mount, the soft arm sagging forward near its rest shape
+// with its gripper, every object and obstacle drawn from its asset's visual parts (the spec's colour
 // override replaces the main part's colour and texture), the ALN goal marker, the spec's lighting
 // and cameras. Object ids: 1 floor, 2 table, 3 mount, 4 arm, 5 gripper, then 6 + i for object i,
 // then the obstacles, then the goal marker.
@@ -82,6 +82,9 @@ inline tabletop::TabletopScene make_spec_scene(const scene::SceneSpec& s, const 
   d.lighting.direction = s.lighting.direction;
   d.lighting.ambient_intensity = static_cast<float>(s.lighting.ambient_intensity);
   d.cameras = s.cameras;
+  // the arm near its rest shape (sagging forward over the far part of the table), out of the objects' way
+  f.rod = tabletop::arc_rod(s.arm_mount.base_position, 1.0, 20, 35.0 * 3.14159265358979323846 / 180.0, 0.05);
+  tabletop::set_gripper(t, f, tabletop::gripper_at_tip(f.rod), 0.10);
   return t;
 }
 
