@@ -303,7 +303,9 @@ TEST_CASE("the reach band: points inside are reachable tool-down by the inverse 
   int corner = 0, corner_ok = 0;
   for (int i = 0; i < 20; ++i) {  // the back corners, with the gripper straight or turned a quarter
     const double h = d.uniform(0.08, 0.30);
-    const Eigen::Vector2d p(d.uniform(0.02, band.corner_x_max - band.margin), (i % 2 ? 1 : -1) * d.uniform(band.corner_y_min + band.margin, 0.48));
+    const double px = d.uniform(0.02, band.corner_x_max - band.margin);
+    const double py = (i % 2 ? 1 : -1) * d.uniform(band.corner_y_min + band.margin, 0.48);
+    const Eigen::Vector2d p(px, py);
     ++corner;
     corner_ok += pose_reachable(statics, tool_down_pose({p.x(), p.y(), top + h}, 0.0), top, 0.05) ||
                  pose_reachable(statics, tool_down_pose({p.x(), p.y(), top + h}, 1.5707963267948966), top, 0.05);

@@ -12,7 +12,8 @@
 // Footprints (circles around the bounding boxes; graspable objects keep the gripper's palm free
 // around them) never overlap. Each draw is checked by SceneValidator; a failing draw is redrawn
 // with the next attempt's engine seed (scene_random.hpp), and the redraws are counted in
-// SceneSpec::sampling. Deterministic: the same request gives the same scene, bit for bit.
+// SceneSpec::sampling. Deterministic: the same request gives the same scene, bit for bit, from g++
+// and clang++ (never two draws in one expression: argument evaluation order is unspecified).
 #pragma once
 
 #include <Eigen/Core>
@@ -165,7 +166,9 @@ class SceneSampler {
     const auto& b = settings_.band;
     const Eigen::Vector2d c = s.table.top_center.head<2>();
     for (int t = 0; t < settings_.placement_tries; ++t) {
-      const Eigen::Vector2d p(d.uniform(c.x() - s.table.half_x, c.x() + s.table.half_x), d.uniform(c.y() - s.table.half_y, c.y() + s.table.half_y));
+      const double px = d.uniform(c.x() - s.table.half_x, c.x() + s.table.half_x);  // one draw per statement: the
+      const double py = d.uniform(c.y() - s.table.half_y, c.y() + s.table.half_y);  // order of arguments is unspecified
+      const Eigen::Vector2d p(px, py);
       if (b.contains(p, h) && on_table(s, p, r) && free(p, r)) return p;
     }
     return std::nullopt;
@@ -209,12 +212,17 @@ class SceneSampler {
     static const std::array<render::TextureKind, 5> tex{render::TextureKind::wood, render::TextureKind::marble, render::TextureKind::fabric,
                                                          render::TextureKind::checker, render::TextureKind::noise};
     s.table.texture = d.pick(tex);
-    s.table.color = Eigen::Vector3d(d.uniform(0.25, 0.85), d.uniform(0.2, 0.8), d.uniform(0.15, 0.75));
+    // one draw per statement (the evaluation order of arguments differs between compilers)
+    s.table.color.x() = d.uniform(0.25, 0.85);
+    s.table.color.y() = d.uniform(0.2, 0.8);
+    s.table.color.z() = d.uniform(0.15, 0.75);
     s.table.secondary_color = s.table.color * d.uniform(0.4, 0.8);
     s.table.texture_scale = d.uniform(4.0, 14.0);
     s.lighting.intensity = d.uniform(0.6, 1.4);
-    s.lighting.color = Eigen::Vector3d(d.uniform(0.8, 1.0), d.uniform(0.8, 1.0), d.uniform(0.8, 1.0));
-    s.lighting.direction = Eigen::Vector3d(d.uniform(-0.6, 0.6), d.uniform(-0.6, 0.6), -1.0);
+    for (int i = 0; i < 3; ++i) s.lighting.color[i] = d.uniform(0.8, 1.0);
+    s.lighting.direction.x() = d.uniform(-0.6, 0.6);
+    s.lighting.direction.y() = d.uniform(-0.6, 0.6);
+    s.lighting.direction.z() = -1.0;
     s.lighting.ambient_intensity = d.uniform(0.25, 0.45);
   }
 
@@ -227,8 +235,9 @@ class SceneSampler {
       for (int t = 0; t < settings_.placement_tries; ++t) {
         const assets::Asset& a = all[static_cast<std::size_t>(d.integer(0, static_cast<int>(all.size()) - 1))];
         const double r = footprint_radius(a);
-        const Eigen::Vector2d p(d.uniform(s.table.top_center.x() - s.table.half_x, s.table.top_center.x() + s.table.half_x),
-                                d.uniform(s.table.top_center.y() - s.table.half_y, s.table.top_center.y() + s.table.half_y));
+        const double px = d.uniform(s.table.top_center.x() - s.table.half_x, s.table.top_center.x() + s.table.half_x);
+        const double py = d.uniform(s.table.top_center.y() - s.table.half_y, s.table.top_center.y() + s.table.half_y);
+        const Eigen::Vector2d p(px, py);
         if (!on_table(s, p, r) || !free(p, r)) continue;
         PlacedAsset o;
         o.asset_id = a.id;
