@@ -3,8 +3,9 @@
 //  COLL  a designated object of one of the paper's 13 categories + a container (basket or bowl);
 //  ALN   a bottle, shoe or candle stick + a goal pose (upright, a yaw) on the table;
 //  STK   2-4 bowls or plates of graded size (strictly decreasing width), goal largest first;
-//  ARR   2-3 objects of Rubik's cube / bottle / pen cup / shoe + one relation (left_of, right_of,
-//        in_front_of, behind, next_to with 2; between, in_a_row with 3) and a free spot for it.
+//  ARR   one relation, each kind equally often (left_of, right_of, in_front_of, behind, next_to with
+//        2-3 objects; between, in_a_row with 3) among Rubik's cube / bottle / pen cup / shoe, and a
+//        free spot for it.
 // clean: only the task's objects, canonical appearance and lighting, upright at yaw 0, positions
 // uniform over the reachable area (ReachBand at each object's grasp height), so they spread
 // evenly over the reachable table area; randomized: also 3-10 obstacles anywhere on the table,
@@ -346,7 +347,11 @@ class SceneSampler {
   }
 
   bool draw_arr(SceneSpec& s, Draw& d) {
-    const int n = d.integer(2, 3);
+    using K = Relation::Kind;
+    static const std::array<K, 7> kinds{K::left_of, K::right_of, K::in_front_of, K::behind, K::next_to, K::between, K::in_a_row};
+    Relation rel;
+    rel.kind = d.pick(kinds);  // each kind equally often
+    const int n = (rel.kind == K::between || rel.kind == K::in_a_row) ? 3 : d.integer(2, 3);
     std::vector<int> idx;
     for (int k = 0; k < n; ++k) {
       const assets::Asset& a = pick_instance(d, d.pick(arr_categories()));
@@ -354,11 +359,6 @@ class SceneSampler {
       if (i < 0) return false;
       idx.push_back(i);
     }
-    Relation rel;
-    using K = Relation::Kind;
-    static const std::array<K, 5> two{K::left_of, K::right_of, K::in_front_of, K::behind, K::next_to};
-    static const std::array<K, 7> three{K::left_of, K::right_of, K::in_front_of, K::behind, K::next_to, K::between, K::in_a_row};
-    rel.kind = n == 2 ? d.pick(two) : d.pick(three);
     rel.objects = {idx[0]};
     if (rel.kind == K::between || rel.kind == K::in_a_row) rel.references = {idx[1], idx[2]};
     else rel.references = {idx[static_cast<std::size_t>(d.integer(1, n - 1))]};
