@@ -15,6 +15,10 @@
 #include "blender_run.hpp"
 #include "render_io.hpp"
 #include "tabletop_render_scene.hpp"
+#if MANISOFT_RENDER_SCENES
+#include "manisoft/scene/scene_json.hpp"
+#include "spec_render_scene.hpp"
+#endif
 
 namespace fs = std::filesystem;
 using namespace manisoft::render;
@@ -53,7 +57,7 @@ int main(int argc, char** argv) {
   std::size_t frame_index = 0;
   int msaa = 0, every = 50, egl_device = -1, samples = 16;
   bool no_shadows = false, episode = false;
-  app.add_option("--scene", scene_path, "scene JSON (not yet supported: the format comes with a later issue)");
+  app.add_option("--scene", scene_path, "scene JSON written by scene_sample (README \"Scenes\")");
   app.add_option("--trace", trace_path, "world_demo CSV trace (README.md, \"world_demo\")");
   app.add_option("--frame", frame_index, "trace row to render (0 = initial state)");
   app.add_option("--renderer", renderer, "gl (in-process OpenGL, default) or blender")->check(CLI::IsMember({"gl", "blender"}));
@@ -68,11 +72,19 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    if (!scene_path.empty()) {
-      manisoft::detail::fail("--scene ", scene_path, ": scene JSON files are not yet supported (the format comes with a later issue); run without --scene for the built-in tabletop scene");
-    }
     if (episode && trace_path.empty()) manisoft::detail::fail("--episode needs --trace");
-    const tabletop::TabletopScene scene = tabletop::make_tabletop_scene();
+    tabletop::TabletopScene scene;
+    if (!scene_path.empty()) {
+#if MANISOFT_RENDER_SCENES
+      if (!trace_path.empty()) manisoft::detail::fail("--trace replays world_demo's built-in scene: it cannot be combined with --scene ", scene_path);
+      const manisoft::scene::AssetLibrary library;
+      scene = spec::make_spec_scene(manisoft::scene::load_scene(scene_path, library), library);
+#else
+      manisoft::detail::fail("--scene ", scene_path, ": this build has no scene component (nlohmann-json and the contact component are needed)");
+#endif
+    } else {
+      scene = tabletop::make_tabletop_scene();
+    }
     io::Trace trace;
     if (!trace_path.empty()) trace = io::read_trace(trace_path);
     const fs::path out(out_dir);

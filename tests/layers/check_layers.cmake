@@ -1,7 +1,7 @@
 # Layer test: every header under include/manisoft/<layer>/ includes only headers of its own layer
 # or of a layer listed before it, and declares only its layer's namespace (manisoft::<layer>,
 # `manisoft` for core). Run: cmake -DINCLUDE_DIR=<repo>/include -P check_layers.cmake
-set(layers core math geometry render assets language rod reward contact rigid interaction world control env task dataset)
+set(layers core math geometry render assets language rod reward contact rigid interaction world control env scene task dataset)
 if(NOT INCLUDE_DIR)
   message(FATAL_ERROR "pass -DINCLUDE_DIR=<repository>/include")
 endif()

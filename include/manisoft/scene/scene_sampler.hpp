@@ -1,0 +1,405 @@
+// Scene samplers of the four tasks in the clean and randomized settings (paper sections 3.2,
+// 3.3 and 3.5, figure 4c; issue 12):
+//  COLL  a designated object of one of the paper's 13 categories + a container (basket or bowl);
+//  ALN   a bottle, shoe or candle stick + a goal pose (upright, a yaw) on the table;
+//  STK   2-4 bowls or plates of graded size (strictly decreasing width), goal largest first;
+//  ARR   one relation, each kind equally often (left_of, right_of, in_front_of, behind, next_to with
+//        2-3 objects; between, in_a_row with 3) among Rubik's cube / bottle / pen cup / shoe, and a
+//        free spot for it.
+// clean: only the task's objects, canonical appearance and lighting, upright at yaw 0, positions
+// uniform over the reachable area (ReachBand at each object's grasp height), so they spread
+// evenly over the reachable table area; randomized: also 3-10 obstacles anywhere on the table,
+// random yaws, table texture and colours, lighting intensity, colour and direction, object colours.
+// Footprints (circles around the bounding boxes; graspable objects keep the gripper's palm free
+// around them) never overlap. Each draw is checked by SceneValidator; a failing draw is redrawn
+// with the next attempt's engine seed (scene_random.hpp), and the redraws are counted in
+// SceneSpec::sampling. Deterministic: the same request gives the same scene, bit for bit, from g++
+// and clang++ (never two draws in one expression: argument evaluation order is unspecified).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "manisoft/core/error.hpp"
+#include "manisoft/scene/asset_library.hpp"
+#include "manisoft/scene/reach_map.hpp"
+#include "manisoft/scene/scene_random.hpp"
+#include "manisoft/scene/scene_spec.hpp"
+#include "manisoft/scene/scene_validation.hpp"
+
+namespace manisoft::scene {
+
+/// The categories each task draws from (the paper's lists).
+inline const std::vector<std::string>& coll_categories() {
+  static const std::vector<std::string> c{"bottle", "pill_bottle", "can", "cup", "sand_clock", "shoe", "candle_stick",
+                                          "box_drink", "kettle", "pen_cup", "sauce_can", "rubiks_cube", "trophy"};
+  return c;
+}
+inline const std::vector<std::string>& coll_containers() {
+  static const std::vector<std::string> c{"basket", "bowl"};
+  return c;
+}
+inline const std::vector<std::string>& aln_categories() {
+  static const std::vector<std::string> c{"bottle", "shoe", "candle_stick"};
+  return c;
+}
+inline const std::vector<std::string>& stk_categories() {
+  static const std::vector<std::string> c{"bowl", "plate"};
+  return c;
+}
+inline const std::vector<std::string>& arr_categories() {
+  static const std::vector<std::string> c{"rubiks_cube", "bottle", "pen_cup", "shoe"};
+  return c;
+}
+
+struct SamplerSettings {
+  int max_attempts = 200;           ///< draws before giving up (an error naming the request)
+  int placement_tries = 200;        ///< rejection-sampling tries per placement
+  double gap = 0.02;                ///< m between footprints
+  double gripper_keepout = 0.08;    ///< m: footprint radius at least this around objects to grasp
+  double table_margin = 0.02;       ///< m from the table edges
+  double min_goal_distance = 0.12;  ///< m: an ALN goal / ARR spot this far from the start at least
+  double relation_distance = 0.15;  ///< m between an ARR object and its reference
+  double fit_clearance = 0.004;     ///< m: a COLL object is this much narrower than the opening
+  int min_obstacles = 3, max_obstacles = 10;
+  ReachBand band;
+  ValidationSettings validation;
+};
+
+struct SampleRequest {
+  Task task = Task::coll;
+  Setting setting = Setting::clean;
+  Split split = Split::train;
+  std::uint64_t index = 0;
+  std::uint64_t seed = 0;
+};
+
+class SceneSampler {
+ public:
+  explicit SceneSampler(SamplerSettings settings = {}) : settings_(settings), validator_(library_, settings.validation) {}
+  SceneSampler(const SceneSampler&) = delete;
+  SceneSampler& operator=(const SceneSampler&) = delete;
+
+  const AssetLibrary& library() const { return library_; }
+  SceneValidator& validator() { return validator_; }
+  const SamplerSettings& settings() const { return settings_; }
+
+  /// The scene of `request`: the first valid draw (SceneSpec::sampling counts the redraws).
+  SceneSpec sample(const SampleRequest& q) {
+    std::vector<std::string> rejections;
+    for (int attempt = 0; attempt < settings_.max_attempts; ++attempt) {
+      const std::uint64_t es = engine_seed(q.split, q.task, q.setting, q.index, q.seed, attempt);
+      std::optional<SceneSpec> s = draw(q, es);
+      std::string why = "placement failed";
+      if (s) {
+        const ValidationResult v = validator_.check(*s);
+        if (v.valid) {
+          s->sampling.engine_seed = es;
+          s->sampling.redraws = attempt;
+          s->sampling.rejections = rejections;
+          return *std::move(s);
+        }
+        why = v.reason;
+      }
+      rejections.push_back(why.substr(0, why.find(':')));
+    }
+    manisoft::detail::fail("SceneSampler: no valid ", to_string(q.task), " ", to_string(q.setting), " scene for index ", q.index, ", seed ", q.seed,
+                           " in ", settings_.max_attempts, " draws");
+  }
+
+  /// One unchecked draw with engine seed `es` (nullopt when a placement found no free spot).
+  std::optional<SceneSpec> draw(const SampleRequest& q, std::uint64_t es) {
+    Draw d(es);
+    SceneSpec s;
+    s.task = q.task;
+    s.setting = q.setting;
+    s.split = q.split;
+    s.index = q.index;
+    s.seed = q.seed;
+    discs_.clear();
+    const bool rnd = q.setting == Setting::randomized;
+    if (rnd) randomize_looks(s, d);
+    bool ok = false;
+    switch (q.task) {
+      case Task::coll: ok = draw_coll(s, d); break;
+      case Task::aln: ok = draw_aln(s, d); break;
+      case Task::stk: ok = draw_stk(s, d); break;
+      case Task::arr: ok = draw_arr(s, d); break;
+    }
+    if (!ok) return std::nullopt;
+    if (rnd && !add_obstacles(s, d)) return std::nullopt;
+    return s;
+  }
+
+ private:
+  struct Disc {
+    Eigen::Vector2d c;
+    double r;
+  };
+
+  const assets::Asset& pick_instance(Draw& d, const std::string& category) {
+    const auto v = library_.category(category);
+    return *d.pick(v);
+  }
+  double grasp_height(const assets::Asset& a) const { return a.grasps.empty() ? asset_height(a) : a.grasps.front().grasp.translation.z(); }
+  double keepout(const assets::Asset& a, bool grasped) const {
+    return grasped ? std::max(footprint_radius(a), settings_.gripper_keepout) : footprint_radius(a);
+  }
+  bool on_table(const SceneSpec& s, const Eigen::Vector2d& p, double r) const {
+    const Eigen::Vector2d c = s.table.top_center.head<2>();
+    return std::abs(p.x() - c.x()) + r + settings_.table_margin <= s.table.half_x && std::abs(p.y() - c.y()) + r + settings_.table_margin <= s.table.half_y;
+  }
+  bool free(const Eigen::Vector2d& p, double r, int ignore = -1) const {
+    for (std::size_t i = 0; i < discs_.size(); ++i)
+      if (static_cast<int>(i) != ignore && (discs_[i].c - p).norm() < discs_[i].r + r + settings_.gap) return false;
+    return true;
+  }
+  /// A free point of the reachable area (ReachBand) at grasp height h for a footprint of radius
+  /// r: uniform over the table, kept when inside the band (rejection sampling).
+  std::optional<Eigen::Vector2d> reachable_spot(const SceneSpec& s, Draw& d, double h, double r) {
+    const auto& b = settings_.band;
+    const Eigen::Vector2d c = s.table.top_center.head<2>();
+    for (int t = 0; t < settings_.placement_tries; ++t) {
+      const double px = d.uniform(c.x() - s.table.half_x, c.x() + s.table.half_x);  // one draw per statement: the
+      const double py = d.uniform(c.y() - s.table.half_y, c.y() + s.table.half_y);  // order of arguments is unspecified
+      const Eigen::Vector2d p(px, py);
+      if (b.contains(p, h) && on_table(s, p, r) && free(p, r)) return p;
+    }
+    return std::nullopt;
+  }
+  double draw_yaw(const assets::Asset& a, bool rnd, Draw& d) const {
+    if (!rnd) return 0.0;
+    return asset_symmetry(a).kind == Symmetry::Kind::axial ? d.uniform(-3.14159265358979323846, 3.14159265358979323846)
+                                                            : d.uniform(-0.25 * 3.14159265358979323846, 0.25 * 3.14159265358979323846);
+  }
+  static math::Pose<double> upright(const assets::Asset& a, const Eigen::Vector2d& p, double top, double yaw) {
+    math::Pose<double> pose;
+    pose.rotation = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * a.resting_poses.front().orientation.toRotationMatrix();
+    pose.translation = Eigen::Vector3d(p.x(), p.y(), top + a.resting_poses.front().height);
+    return pose;
+  }
+  /// Places asset `a` in the reachable band at height h; returns its object index or -1.
+  int place_object(SceneSpec& s, Draw& d, const assets::Asset& a, double h, bool grasped) {
+    const double r = keepout(a, grasped);
+    const auto p = reachable_spot(s, d, h, r);
+    if (!p) return -1;
+    PlacedAsset o;
+    o.asset_id = a.id;
+    o.pose = upright(a, *p, s.table.top_center.z(), draw_yaw(a, s.setting == Setting::randomized, d));
+    if (s.setting == Setting::randomized && d.chance(0.5)) recolor(o.appearance, d);
+    s.objects.push_back(o);
+    discs_.push_back({*p, r});
+    return static_cast<int>(s.objects.size()) - 1;
+  }
+
+  static void recolor(Appearance& ap, Draw& d) {
+    const auto& pal = assets::catalog_detail::palette();
+    const auto& c = d.pick(pal);
+    ap.override_color = true;
+    ap.color = Eigen::Vector3d(c.r, c.g, c.b);
+    ap.color_name = c.name;
+    static const std::array<render::TextureKind, 3> tex{render::TextureKind::none, render::TextureKind::noise, render::TextureKind::fabric};
+    ap.texture = d.pick(tex);
+  }
+
+  void randomize_looks(SceneSpec& s, Draw& d) {
+    static const std::array<render::TextureKind, 5> tex{render::TextureKind::wood, render::TextureKind::marble, render::TextureKind::fabric,
+                                                         render::TextureKind::checker, render::TextureKind::noise};
+    s.table.texture = d.pick(tex);
+    // one draw per statement (the evaluation order of arguments differs between compilers)
+    s.table.color.x() = d.uniform(0.25, 0.85);
+    s.table.color.y() = d.uniform(0.2, 0.8);
+    s.table.color.z() = d.uniform(0.15, 0.75);
+    s.table.secondary_color = s.table.color * d.uniform(0.4, 0.8);
+    s.table.texture_scale = d.uniform(4.0, 14.0);
+    s.lighting.intensity = d.uniform(0.6, 1.4);
+    for (int i = 0; i < 3; ++i) s.lighting.color[i] = d.uniform(0.8, 1.0);
+    s.lighting.direction.x() = d.uniform(-0.6, 0.6);
+    s.lighting.direction.y() = d.uniform(-0.6, 0.6);
+    s.lighting.direction.z() = -1.0;
+    s.lighting.ambient_intensity = d.uniform(0.25, 0.45);
+  }
+
+  /// Places 3-10 obstacles; false when fewer than the drawn count found room.
+  bool add_obstacles(SceneSpec& s, Draw& d) {
+    const int n = d.integer(settings_.min_obstacles, settings_.max_obstacles);
+    const auto& all = library_.obstacles();
+    const double top = s.table.top_center.z();
+    for (int k = 0; k < n; ++k) {
+      for (int t = 0; t < settings_.placement_tries; ++t) {
+        const assets::Asset& a = all[static_cast<std::size_t>(d.integer(0, static_cast<int>(all.size()) - 1))];
+        const double r = footprint_radius(a);
+        const double px = d.uniform(s.table.top_center.x() - s.table.half_x, s.table.top_center.x() + s.table.half_x);
+        const double py = d.uniform(s.table.top_center.y() - s.table.half_y, s.table.top_center.y() + s.table.half_y);
+        const Eigen::Vector2d p(px, py);
+        if (!on_table(s, p, r) || !free(p, r)) continue;
+        PlacedAsset o;
+        o.asset_id = a.id;
+        o.pose = upright(a, p, top, d.uniform(-3.14159265358979323846, 3.14159265358979323846));
+        if (d.chance(0.5)) recolor(o.appearance, d);
+        s.obstacles.push_back(o);
+        discs_.push_back({p, r});
+        break;
+      }
+    }
+    return static_cast<int>(s.obstacles.size()) == n;
+  }
+
+  /// Whether `obj` fits through the opening of `container` (round: its footprint circle; square:
+  /// its larger side) with `fit_clearance` to spare.
+  bool fits(const assets::Asset& obj, const assets::Asset& container) const {
+    if (container.receptacles.empty()) return false;
+    const auto& r = container.receptacles.front();
+    if (r.inner_radius > 0) return 2 * footprint_radius(obj) <= 2 * r.inner_radius - settings_.fit_clearance;
+    return 2 * std::max(obj.bounding_half_extents.x(), obj.bounding_half_extents.y()) <= 2 * r.inner_half_extents.minCoeff() - settings_.fit_clearance;
+  }
+
+  bool draw_coll(SceneSpec& s, Draw& d) {
+    // the category uniformly; within it an instance that fits some container (all instances when
+    // none does: the catalogue's containers are at most 8.5 cm wide)
+    const auto instances = library_.category(d.pick(coll_categories()));
+    std::vector<const assets::Asset*> containers;
+    for (const auto& c : coll_containers())
+      for (const auto* a : library_.category(c)) containers.push_back(a);
+    std::vector<const assets::Asset*> fitting;
+    for (const auto* o : instances)
+      for (const auto* c : containers)
+        if (fits(*o, *c)) {
+          fitting.push_back(o);
+          break;
+        }
+    const assets::Asset& obj = *d.pick(fitting.empty() ? instances : fitting);
+    std::vector<const assets::Asset*> hosts;
+    for (const auto* c : containers)
+      if (fits(obj, *c)) hosts.push_back(c);
+    if (hosts.empty()) {  // the widest opening
+      const assets::Asset* widest = containers.front();
+      for (const auto* c : containers)
+        if (c->bounding_half_extents.x() > widest->bounding_half_extents.x()) widest = c;
+      hosts.push_back(widest);
+    }
+    const assets::Asset& box = *d.pick(hosts);
+    const double place_h = asset_height(box) + grasp_height(obj) + settings_.validation.place_clearance;
+    const int c = place_object(s, d, box, place_h, false);
+    if (c < 0) return false;
+    const int o = place_object(s, d, obj, grasp_height(obj), true);
+    if (o < 0) return false;
+    s.goal.object = o;
+    s.goal.container = c;
+    return true;
+  }
+
+  bool draw_aln(SceneSpec& s, Draw& d) {
+    const assets::Asset& obj = pick_instance(d, d.pick(aln_categories()));
+    const double h = grasp_height(obj);
+    const int o = place_object(s, d, obj, h, true);
+    if (o < 0) return false;
+    const double r = keepout(obj, true);
+    for (int t = 0; t < settings_.placement_tries; ++t) {
+      const auto p = reachable_spot(s, d, h, r);
+      if (!p) return false;
+      if ((*p - s.objects[static_cast<std::size_t>(o)].pose.translation.head<2>()).norm() < settings_.min_goal_distance) continue;
+      s.goal.object = o;
+      s.goal.goal_pose = upright(obj, *p, s.table.top_center.z(), d.uniform(-0.5 * 3.14159265358979323846, 0.5 * 3.14159265358979323846));
+      s.goal.symmetry = asset_symmetry(obj);
+      discs_.push_back({*p, r});  // keeps obstacles off the goal
+      return true;
+    }
+    return false;
+  }
+
+  bool draw_stk(SceneSpec& s, Draw& d) {
+    const auto inst = library_.category(d.pick(stk_categories()));
+    // distinct widths, largest first
+    std::vector<const assets::Asset*> by_width;
+    for (const auto* a : inst) {
+      bool dup = false;
+      for (const auto* b : by_width) dup = dup || std::abs(b->bounding_half_extents.x() - a->bounding_half_extents.x()) < 1e-3;
+      if (!dup) by_width.push_back(a);
+    }
+    const int n = std::min(d.integer(2, 4), static_cast<int>(by_width.size()));
+    // choose n of them (keep order by width after the choice)
+    std::vector<const assets::Asset*> chosen = by_width;
+    while (static_cast<int>(chosen.size()) > n) chosen.erase(chosen.begin() + d.integer(0, static_cast<int>(chosen.size()) - 1));
+    std::sort(chosen.begin(), chosen.end(), [](const assets::Asset* a, const assets::Asset* b) {
+      return a->bounding_half_extents.x() > b->bounding_half_extents.x();
+    });
+    double stack = 0;
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      const auto* a = chosen[k];
+      // the bottom item's band is where the whole stack is placed: reachable at its top
+      const double h = k == 0 ? 0.0 : grasp_height(*a);
+      if (k == 0) {
+        for (std::size_t j = 0; j < chosen.size(); ++j) stack += asset_height(*chosen[j]);
+      }
+      const int i = place_object(s, d, *a, k == 0 ? stack - asset_height(*chosen.back()) + grasp_height(*chosen.back()) + settings_.validation.place_clearance : h, true);
+      if (i < 0) return false;
+      s.goal.items.push_back(i);
+    }
+    return true;
+  }
+
+  bool draw_arr(SceneSpec& s, Draw& d) {
+    using K = Relation::Kind;
+    static const std::array<K, 7> kinds{K::left_of, K::right_of, K::in_front_of, K::behind, K::next_to, K::between, K::in_a_row};
+    Relation rel;
+    rel.kind = d.pick(kinds);  // each kind equally often
+    const int n = (rel.kind == K::between || rel.kind == K::in_a_row) ? 3 : d.integer(2, 3);
+    std::vector<int> idx;
+    for (int k = 0; k < n; ++k) {
+      const assets::Asset& a = pick_instance(d, d.pick(arr_categories()));
+      const int i = place_object(s, d, a, grasp_height(a), true);
+      if (i < 0) return false;
+      idx.push_back(i);
+    }
+    rel.objects = {idx[0]};
+    if (rel.kind == K::between || rel.kind == K::in_a_row) rel.references = {idx[1], idx[2]};
+    else rel.references = {idx[static_cast<std::size_t>(d.integer(1, n - 1))]};
+    const auto& a = library_.get(s.objects[static_cast<std::size_t>(idx[0])].asset_id, "ARR object");
+    const double r = keepout(a, true), h = grasp_height(a);
+    auto pos = [&](int i) { return Eigen::Vector2d(s.objects[static_cast<std::size_t>(i)].pose.translation.head<2>()); };
+    auto ref_r = [&](int i) { return discs_[static_cast<std::size_t>(i)].r; };
+    std::vector<Eigen::Vector2d> candidates;
+    const Eigen::Vector2d b = pos(rel.references[0]);
+    const double dist = std::max(settings_.relation_distance, r + ref_r(rel.references[0]) + settings_.gap);
+    switch (rel.kind) {
+      case K::left_of: candidates = {b + Eigen::Vector2d(0, -dist)}; break;
+      case K::right_of: candidates = {b + Eigen::Vector2d(0, dist)}; break;
+      case K::in_front_of: candidates = {b + Eigen::Vector2d(dist, 0)}; break;
+      case K::behind: candidates = {b + Eigen::Vector2d(-dist, 0)}; break;
+      case K::next_to: candidates = {b + Eigen::Vector2d(0, dist), b + Eigen::Vector2d(0, -dist), b + Eigen::Vector2d(dist, 0), b + Eigen::Vector2d(-dist, 0)}; break;
+      case K::between: candidates = {0.5 * (b + pos(rel.references[1]))}; break;
+      case K::in_a_row: {
+        const Eigen::Vector2d c = pos(rel.references[1]);
+        const Eigen::Vector2d u = (c - b).normalized();
+        const double step = std::max((c - b).norm(), dist);
+        candidates = {c + step * u, b - step * u, 0.5 * (b + c)};
+        break;
+      }
+    }
+    const Eigen::Vector2d start = pos(idx[0]);
+    for (const auto& p : candidates) {
+      if (!settings_.band.contains(p, h) || !on_table(s, p, r) || !free(p, r, idx[0])) continue;
+      if ((p - start).norm() < settings_.min_goal_distance) continue;
+      rel.spots = {Eigen::Vector3d(p.x(), p.y(), s.objects[static_cast<std::size_t>(idx[0])].pose.translation.z())};
+      discs_.push_back({p, r});
+      s.goal.relations = {rel};
+      return true;
+    }
+    return false;
+  }
+
+  SamplerSettings settings_;
+  AssetLibrary library_;
+  SceneValidator validator_;
+  std::vector<Disc> discs_;
+};
+
+}  // namespace manisoft::scene

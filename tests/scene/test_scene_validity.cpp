@@ -1,0 +1,263 @@
+// Sampled scenes checked independently of the sampler's own validation: footprints as oriented
+// rectangles (separating axes, not the sampler's circles) do not overlap and lie on the table;
+// every object stays at rest in a rigid world stepped at the arm world's 2e-4 s (not the
+// validator's 1 ms); goals are well formed (COLL categories and containers, STK widths strictly
+// decreasing, ALN goal away from the start, ARR spot satisfying its relation with the task's
+// margins); clean scenes carry no obstacles or overrides, randomized ones 3-10 obstacles; and the
+// coverage of categories, relation kinds and of the reachable band's area. The default cases sample
+// 20-60 scenes per task and setting; the hidden "[slow]" case (ctest label slow) runs 1,000.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "manisoft/scene/scene_sampler.hpp"
+#include "manisoft/scene/scene_world.hpp"
+
+using namespace manisoft;
+using namespace manisoft::scene;
+
+namespace {
+
+struct Rect {
+  Eigen::Vector2d c, ax, ay;  ///< centre and half axes
+};
+
+Rect footprint(const assets::Asset& a, const math::Pose<double>& p) {
+  const Eigen::Vector2d ex = p.rotation.col(0).head<2>().normalized(), ey(-ex.y(), ex.x());
+  const Eigen::Vector3d c = p.translation + p.rotation * a.bounding_center;
+  return Rect{c.head<2>(), ex * a.bounding_half_extents.x(), ey * a.bounding_half_extents.y()};
+}
+
+bool rects_overlap(const Rect& a, const Rect& b) {
+  for (const Eigen::Vector2d& axis_raw : {a.ax, a.ay, b.ax, b.ay}) {
+    if (axis_raw.norm() < 1e-12) continue;
+    const Eigen::Vector2d n = axis_raw.normalized();
+    const double ra = std::abs(a.ax.dot(n)) + std::abs(a.ay.dot(n));
+    const double rb = std::abs(b.ax.dot(n)) + std::abs(b.ay.dot(n));
+    if (std::abs((a.c - b.c).dot(n)) > ra + rb) return false;
+  }
+  return true;
+}
+
+struct Stats {
+  std::map<std::string, int> categories, containers, relations;
+  std::map<std::size_t, int> stack_sizes;
+  std::set<std::pair<int, int>> band_cells_hit;
+  int redraws = 0, scenes = 0;
+  double seconds = 0;
+};
+
+/// 10 cm cells of the table whose centre lies in the band at grasp height 0.12 m (not the edge
+/// cells: a graspable object's centre keeps 10 cm from the edges).
+std::set<std::pair<int, int>> band_cells(const ReachBand& band) {
+  std::set<std::pair<int, int>> out;
+  for (int ix = 1; ix < 7; ++ix)
+    for (int iy = 1; iy < 9; ++iy)
+      if (band.contains(Eigen::Vector2d(0.05 + 0.1 * ix, -0.45 + 0.1 * iy), 0.12)) out.insert({ix, iy});
+  return out;
+}
+
+void check_scene(const SceneSpec& s, const AssetLibrary& lib, Stats& st) {
+  INFO(to_string(s.task) << " " << to_string(s.setting) << " index " << s.index);
+  const double top = s.table.top_center.z();
+  // footprints: on the table, no overlap (objects and obstacles)
+  std::vector<Rect> rects;
+  for (const auto* list : {&s.objects, &s.obstacles})
+    for (const auto& o : *list) {
+      const auto& a = lib.get(o.asset_id, "test");
+      const Rect r = footprint(a, o.pose);
+      const double ex = std::abs(r.ax.x()) + std::abs(r.ay.x()), ey = std::abs(r.ax.y()) + std::abs(r.ay.y());
+      REQUIRE(std::abs(r.c.x() - s.table.top_center.x()) + ex <= s.table.half_x);
+      REQUIRE(std::abs(r.c.y() - s.table.top_center.y()) + ey <= s.table.half_y);
+      REQUIRE(std::abs(o.pose.translation.z() - top) < 1e-12);  // upright on the top
+      for (const auto& q : rects) REQUIRE(!rects_overlap(r, q));
+      rects.push_back(r);
+    }
+  // at rest in a rigid world at 2e-4 s: 0.3 s settling, then at most 2 mm and 3 degrees over 0.2 s
+  {
+    rigid::RigidWorld w;
+    const SceneBodies b = populate_rigid_world(w, s, lib);
+    for (int i = 0; i < 1500; ++i) w.step(2e-4);
+    std::vector<Eigen::Vector3d> x;
+    std::vector<Eigen::Quaterniond> q;
+    for (auto id : b.objects) {
+      x.push_back(w.position(id));
+      q.push_back(w.orientation(id));
+    }
+    for (int i = 0; i < 1000; ++i) w.step(2e-4);
+    for (std::size_t i = 0; i < b.objects.size(); ++i) {
+      REQUIRE((w.position(b.objects[i]) - x[i]).norm() <= 0.002);
+      REQUIRE(w.orientation(b.objects[i]).angularDistance(q[i]) <= 3.0 * 3.14159265358979323846 / 180);
+    }
+  }
+  // setting
+  if (s.setting == Setting::clean) {
+    REQUIRE(s.obstacles.empty());
+    for (const auto& o : s.objects) {
+      REQUIRE(!o.appearance.override_color);
+      REQUIRE(std::abs(o.pose.rotation(0, 0) - 1.0) < 1e-12);  // canonical yaw 0
+    }
+    REQUIRE(s.lighting.intensity == 1.0);
+  } else {
+    REQUIRE(s.obstacles.size() >= 3u);
+    REQUIRE(s.obstacles.size() <= 10u);
+  }
+  auto category = [&](int i) { return lib.get(s.objects[static_cast<std::size_t>(i)].asset_id, "test").category; };
+  auto xy = [&](int i) { return Eigen::Vector2d(s.objects[static_cast<std::size_t>(i)].pose.translation.head<2>()); };
+  switch (s.task) {
+    case Task::coll: {
+      REQUIRE(s.objects.size() == 2u);
+      const auto& cats = coll_categories();
+      REQUIRE(std::find(cats.begin(), cats.end(), category(s.goal.object)) != cats.end());
+      REQUIRE(!lib.get(s.objects[static_cast<std::size_t>(s.goal.container)].asset_id, "t").receptacles.empty());
+      ++st.categories[category(s.goal.object)];
+      ++st.containers[category(s.goal.container)];
+      break;
+    }
+    case Task::aln: {
+      REQUIRE(s.objects.size() == 1u);
+      const std::string c = category(s.goal.object);
+      REQUIRE((c == "bottle" || c == "shoe" || c == "candle_stick"));
+      REQUIRE((s.goal.goal_pose.translation.head<2>() - xy(s.goal.object)).norm() >= 0.12);
+      REQUIRE(s.goal.goal_pose.translation.z() == top);
+      ++st.categories[c];
+      break;
+    }
+    case Task::stk: {
+      REQUIRE(s.goal.items.size() >= 2u);
+      REQUIRE(s.goal.items.size() <= 4u);
+      for (std::size_t k = 1; k < s.goal.items.size(); ++k) {
+        const auto& lower = lib.get(s.objects[static_cast<std::size_t>(s.goal.items[k - 1])].asset_id, "t");
+        const auto& upper = lib.get(s.objects[static_cast<std::size_t>(s.goal.items[k])].asset_id, "t");
+        REQUIRE(lower.bounding_half_extents.x() > upper.bounding_half_extents.x() + 1e-3);  // graded: largest first
+        REQUIRE(lower.category == upper.category);
+      }
+      ++st.stack_sizes[s.goal.items.size()];
+      ++st.categories[category(s.goal.items.front())];
+      break;
+    }
+    case Task::arr: {
+      REQUIRE(s.goal.relations.size() == 1u);
+      const auto& r = s.goal.relations.front();
+      REQUIRE(r.spots.size() == 1u);
+      for (std::size_t i = 0; i < s.objects.size(); ++i) ++st.categories[category(static_cast<int>(i))];
+      ++st.relations[std::string(to_string(r.kind))];
+      const Eigen::Vector2d a = r.spots[0].head<2>(), b = xy(r.references[0]);
+      REQUIRE((a - xy(r.objects[0])).norm() >= 0.12);  // the object must move
+      // the relation holds at the spot with the task's margins (task/success.hpp, Tolerances)
+      const Eigen::Vector2d d = a - b;
+      switch (r.kind) {
+        case Relation::Kind::left_of: REQUIRE((-d.y() >= 0.05 && -d.y() <= 0.30 && std::abs(d.x()) <= 0.08)); break;
+        case Relation::Kind::right_of: REQUIRE((d.y() >= 0.05 && d.y() <= 0.30 && std::abs(d.x()) <= 0.08)); break;
+        case Relation::Kind::in_front_of: REQUIRE((d.x() >= 0.05 && d.x() <= 0.30 && std::abs(d.y()) <= 0.08)); break;
+        case Relation::Kind::behind: REQUIRE((-d.x() >= 0.05 && -d.x() <= 0.30 && std::abs(d.y()) <= 0.08)); break;
+        case Relation::Kind::next_to: REQUIRE(d.norm() <= 0.20); break;
+        case Relation::Kind::between:
+        case Relation::Kind::in_a_row: {
+          const Eigen::Vector2d c = xy(r.references[1]);
+          const Eigen::Vector2d u = (c - b).normalized();
+          const Eigen::Vector2d off = d - d.dot(u) * u;
+          REQUIRE(off.norm() <= 0.03);
+          if (r.kind == Relation::Kind::between) {
+            const double t = d.dot(u) / (c - b).norm();
+            REQUIRE((t >= 0.25 && t <= 0.75));
+          }
+          break;
+        }
+      }
+      break;
+    }
+  }
+  if (s.setting == Setting::clean) {
+    for (const auto& o : s.objects) {
+      const int ix = static_cast<int>(std::floor(o.pose.translation.x() / 0.1)), iy = static_cast<int>(std::floor((o.pose.translation.y() + 0.5) / 0.1));
+      st.band_cells_hit.insert({ix, iy});
+    }
+  }
+  st.redraws += s.sampling.redraws;
+  ++st.scenes;
+}
+
+void run(int per_cell, bool report, const std::vector<Task>& tasks, bool kinds = true) {
+  SceneSampler sampler;
+  std::map<std::pair<Task, Setting>, Stats> all;
+  for (Task t : tasks)
+    for (Setting st : {Setting::clean, Setting::randomized}) {
+      Stats& stats = all[{t, st}];
+      const auto t0 = std::chrono::steady_clock::now();
+      std::vector<SceneSpec> scenes;
+      for (int i = 0; i < per_cell; ++i) {
+        SampleRequest q;
+        q.task = t;
+        q.setting = st;
+        q.index = static_cast<std::uint64_t>(i);
+        q.seed = 1;
+        scenes.push_back(sampler.sample(q));
+      }
+      stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      for (const auto& s : scenes) check_scene(s, sampler.library(), stats);
+      if (report)
+        std::printf("%s %-10s: %d scenes valid, %d redraws (%.3f per scene), sampling + validation %.2f ms per scene\n", std::string(to_string(t)).c_str(),
+                    std::string(to_string(st)).c_str(), stats.scenes, stats.redraws, double(stats.redraws) / stats.scenes, 1e3 * stats.seconds / stats.scenes);
+    }
+  // coverage: every category the task allows appears (COLL with 100 scenes: the clean COLL cell
+  // alone has 13 categories)
+  std::map<std::string, int> coll, arr, aln, stk, rel, containers;
+  std::set<std::pair<int, int>> hit;
+  std::map<std::size_t, int> sizes;
+  for (auto& [key, st] : all) {
+    auto& dst = key.first == Task::coll ? coll : key.first == Task::arr ? arr : key.first == Task::aln ? aln : stk;
+    for (auto& [c, n] : st.categories) dst[c] += n;
+    for (auto& [c, n] : st.relations) rel[c] += n;
+    for (auto& [c, n] : st.containers) containers[c] += n;
+    for (auto& [c, n] : st.stack_sizes) sizes[c] += n;
+    hit.insert(st.band_cells_hit.begin(), st.band_cells_hit.end());
+  }
+  auto has = [&](Task t) { return kinds && std::find(tasks.begin(), tasks.end(), t) != tasks.end(); };
+  if (has(Task::coll)) {
+    for (const auto& c : coll_categories()) {
+      INFO("COLL category " << c);
+      REQUIRE(coll[c] > 0);
+    }
+    for (const auto& c : coll_containers()) REQUIRE(containers[c] > 0);
+  }
+  if (has(Task::aln))
+    for (const auto& c : aln_categories()) REQUIRE(aln[c] > 0);
+  if (has(Task::arr)) {
+    for (const auto& c : arr_categories()) REQUIRE(arr[c] > 0);
+    for (const char* k : {"left_of", "right_of", "in_front_of", "behind", "next_to", "between", "in_a_row"}) {
+      INFO("relation " << k);
+      REQUIRE(rel[k] > 0);
+    }
+  }
+  if (has(Task::stk)) {
+    for (const auto& c : stk_categories()) REQUIRE(stk[c] > 0);
+    for (std::size_t n : {2u, 3u, 4u}) REQUIRE(sizes[n] > 0);
+  }
+  // placements cover the reachable band: clean objects land in most of its 10 cm cells
+  const auto cells = band_cells(sampler.settings().band);
+  int covered = 0;
+  for (const auto& c : cells) covered += hit.count(c) > 0;
+  if (report) std::printf("band cells (10 cm, centre in the band at 0.12 m): %zu, hit by clean placements: %d\n", cells.size(), covered);
+  REQUIRE(cells.size() >= 15u);
+  if (tasks.size() == 4) REQUIRE(covered >= static_cast<int>(0.9 * static_cast<double>(cells.size())));
+}
+
+}  // namespace
+
+TEST_CASE("COLL: 60 clean + 60 randomized scenes valid, all 13 categories and both containers appear", "[scene]") { run(60, false, {Task::coll}); }
+TEST_CASE("ALN: 30 clean + 30 randomized scenes valid, every category appears", "[scene]") { run(30, false, {Task::aln}); }
+TEST_CASE("STK: 30 clean + 30 randomized scenes valid, both categories and 2, 3, 4 items appear", "[scene]") { run(30, false, {Task::stk}); }
+TEST_CASE("ARR: 40 clean + 40 randomized scenes valid, every category and relation kind appears", "[scene]") { run(40, false, {Task::arr}); }
+TEST_CASE("clean placements cover the reachable band (15 scenes per task and setting)", "[scene]") {
+  run(15, false, {Task::coll, Task::aln, Task::stk, Task::arr}, false);
+}
+
+TEST_CASE("1,000 sampled scenes per task and setting are valid (slow)", "[.][slow]") { run(1000, true, {Task::coll, Task::aln, Task::stk, Task::arr}); }
