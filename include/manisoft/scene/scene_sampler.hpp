@@ -30,7 +30,6 @@
 #include "manisoft/core/error.hpp"
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/scene/reach_map.hpp"
-#include "manisoft/scene/scene_instructions.hpp"
 #include "manisoft/scene/scene_random.hpp"
 #include "manisoft/scene/scene_spec.hpp"
 #include "manisoft/scene/scene_validation.hpp"
@@ -72,7 +71,6 @@ struct SamplerSettings {
   int min_obstacles = 3, max_obstacles = 10;
   ReachBand band;
   ValidationSettings validation;
-  std::string language_dir;         ///< instruction templates and nouns; "" = the shipped ones
 };
 
 struct SampleRequest {
@@ -85,10 +83,7 @@ struct SampleRequest {
 
 class SceneSampler {
  public:
-  explicit SceneSampler(SamplerSettings settings = {})
-      : settings_(settings),
-        validator_(library_, settings.validation),
-        language_(settings.language_dir.empty() ? language::Library::load_default() : language::Library::load(settings.language_dir)) {}
+  explicit SceneSampler(SamplerSettings settings = {}) : settings_(settings), validator_(library_, settings.validation) {}
   SceneSampler(const SceneSampler&) = delete;
   SceneSampler& operator=(const SceneSampler&) = delete;
 
@@ -105,14 +100,13 @@ class SceneSampler {
       std::string why = "placement failed";
       if (s) {
         const ValidationResult v = validator_.check(*s);
-        // Valid and describable: every goal object has a unique referring expression.
-        if (v.valid && describe(*s, library_, language_, es ^ 0x9e3779b97f4a7c15ull)) {
+        if (v.valid) {
           s->sampling.engine_seed = es;
           s->sampling.redraws = attempt;
           s->sampling.rejections = rejections;
           return *std::move(s);
         }
-        why = v.valid ? "ambiguous: a goal object has no unique referring expression" : v.reason;
+        why = v.reason;
       }
       rejections.push_back(why.substr(0, why.find(':')));
     }
@@ -405,7 +399,6 @@ class SceneSampler {
   SamplerSettings settings_;
   AssetLibrary library_;
   SceneValidator validator_;
-  language::Library language_;
   std::vector<Disc> discs_;
 };
 
