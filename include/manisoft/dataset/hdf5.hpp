@@ -164,29 +164,15 @@ class File {
   /// The shape of the dataset at `path`.
   std::vector<hsize_t> shape(const std::string& path) const {
     ScopedSilence silence;
-    if (!exists(path)) fail_at(name_, path, "missing dataset");
-    Handle data(H5Dopen2(id(), path.c_str(), H5P_DEFAULT), H5Dclose);
-    if (!data.valid()) fail_at(name_, path, "cannot open the dataset (not a dataset, or the file is damaged)");
-    Handle space(H5Dget_space(data.get()), H5Sclose);
-    const int rank = H5Sget_simple_extent_ndims(space.get());
-    if (rank < 0) fail_at(name_, path, "unreadable dataspace");
-    std::vector<hsize_t> dims(static_cast<std::size_t>(rank), 0);
-    H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
-    return dims;
+    return dims_of(open_dataset(path), path);
   }
 
   /// Reads a whole dataset as T (converted by HDF5 from the stored type); `shape` gets its shape.
   template <typename T>
   std::vector<T> read(const std::string& path, std::vector<hsize_t>& shape) const {
     ScopedSilence silence;
-    if (!exists(path)) fail_at(name_, path, "missing dataset");
-    Handle data(H5Dopen2(id(), path.c_str(), H5P_DEFAULT), H5Dclose);
-    if (!data.valid()) fail_at(name_, path, "cannot open the dataset (not a dataset, or the file is damaged)");
-    Handle space(H5Dget_space(data.get()), H5Sclose);
-    const int rank = H5Sget_simple_extent_ndims(space.get());
-    if (rank < 0) fail_at(name_, path, "unreadable dataspace");
-    shape.assign(static_cast<std::size_t>(rank), 0);
-    H5Sget_simple_extent_dims(space.get(), shape.data(), nullptr);
+    const Handle data = open_dataset(path);
+    shape = dims_of(data, path);
     hsize_t count = 1;
     for (hsize_t s : shape) count *= s;
     std::vector<T> values(count);
@@ -344,6 +330,22 @@ class File {
     Handle attribute(H5Aopen_by_name(id(), path.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
     if (!attribute.valid()) fail_at(name_, path, "cannot open attribute '", name, "'");
     return attribute;
+  }
+
+  Handle open_dataset(const std::string& path) const {
+    if (!exists(path)) fail_at(name_, path, "missing dataset");
+    Handle data(H5Dopen2(id(), path.c_str(), H5P_DEFAULT), H5Dclose);
+    if (!data.valid()) fail_at(name_, path, "cannot open the dataset (not a dataset, or the file is damaged)");
+    return data;
+  }
+
+  std::vector<hsize_t> dims_of(const Handle& data, const std::string& path) const {
+    Handle space(H5Dget_space(data.get()), H5Sclose);
+    const int rank = H5Sget_simple_extent_ndims(space.get());
+    if (rank < 0) fail_at(name_, path, "unreadable dataspace");
+    std::vector<hsize_t> dims(static_cast<std::size_t>(rank), 0);
+    H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
+    return dims;
   }
 
   std::string indexed_name(hid_t location, const std::string& path, hsize_t i, bool attribute) const {
