@@ -53,12 +53,12 @@ struct SceneBodies {
   std::vector<rigid::BodyId> objects, obstacles;
 };
 
-/// Adds the spec's table (and floor), obstacles (static) and objects (dynamic) to `world`.
+/// Adds the spec's obstacles (static) and objects (dynamic) to `world` (which has its table
+/// already: SceneBodies::table is left 0).
 template <typename Rod>
-SceneBodies populate_arm_world(world::ArmWorld<Rod>& world, const SceneSpec& s, const AssetLibrary& lib) {
+SceneBodies populate_objects(world::ArmWorld<Rod>& world, const SceneSpec& s, const AssetLibrary& lib) {
   require_world_mount(s);
   SceneBodies b;
-  b.table = world.add_table(s.table.desc());
   for (std::size_t i = 0; i < s.obstacles.size(); ++i) {
     const auto& o = s.obstacles[i];
     const auto& a = lib.get(o.asset_id, "obstacles[" + std::to_string(i) + "]");
@@ -69,6 +69,16 @@ SceneBodies populate_arm_world(world::ArmWorld<Rod>& world, const SceneSpec& s, 
     const auto& a = lib.get(o.asset_id, "objects[" + std::to_string(i) + "]");
     b.objects.push_back(world.add_object(asset_body(a, o.pose, false, body_name(false, i, o.asset_id))));
   }
+  return b;
+}
+
+/// Adds the spec's table (and floor), obstacles (static) and objects (dynamic) to `world`.
+template <typename Rod>
+SceneBodies populate_arm_world(world::ArmWorld<Rod>& world, const SceneSpec& s, const AssetLibrary& lib) {
+  require_world_mount(s);
+  const rigid::BodyId table = world.add_table(s.table.desc());
+  SceneBodies b = populate_objects(world, s, lib);
+  b.table = table;
   return b;
 }
 

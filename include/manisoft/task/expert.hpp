@@ -1,0 +1,480 @@
+// The expert of the four ManiSoft tasks (paper section 3.4: a rule-based planner per task whose
+// SE(3) waypoints and gripper states are tracked by the model executor; issue 13, section 3).
+//
+//   task::Expert expert(env);       // env: a task::TaskEnv
+//   env.reset(spec);  expert.reset();
+//   while (!env.done()) { expert.act(torques, S); env.step(torques, S); }
+//
+// Planner: every task is a list of moves "put object i at pose P" (asset frame -> world):
+//   COLL  the object over the container's receptacle, its bottom place_clearance above the rim;
+//   ALN   the object at the goal pose (the symmetric equivalent nearest its current yaw);
+//   STK   items[k] onto items[k-1] for k = 1, 2, ... (on the receptacle of the item below, or on
+//         its top), the item below read when the move starts;
+//   ARR   each relation's object at the free spot the scene gives for it (Relation::spots).
+// Orientation: kept as the object stands (translation only) except ALN's yaw.
+// Grasp: among the asset's annotated grasps, each also turned half a turn about the fingers' axis
+// (the parallel gripper is symmetric), the one whose grasp and place end-effector poses turn least
+// from the home pose, whose whole sequence the executor accepts (continuous shapes within the
+// actuation limits, the payload included) and whose waypoint shapes keep every rod node
+// table_clearance above the table top.
+// Waypoints of a move (the end-effector frame; straight lines with quintic timing,
+// ModelExecutor::track_line): approach (the annotation's), grasp, close once settled, carry
+// (above the place pose, diagonal from the grasp), place (corrected for where the object sits in
+// the hand, measured when it is held), open once settled, then up by retract_height when another
+// move follows. A missed grasp re-opens and retries the move from its approach (max_retries).
+// Deterministic; allocation only when a move is planned (path set-ups copy the executor).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "manisoft/control/arm_observation.hpp"
+#include "manisoft/control/model_executor.hpp"
+#include "manisoft/core/error.hpp"
+#include "manisoft/scene/asset_library.hpp"
+#include "manisoft/task/task_env.hpp"
+
+namespace manisoft::task {
+
+struct ExpertConfig {
+  double carry_height = 0.05;       ///< m: end-effector above the place pose before lowering
+  double lift_height = 0.06;        ///< m: straight up from the grasp first (a "via" carry)
+  double place_clearance = 0.008;   ///< m: the object's bottom above its support when released
+  double retract_height = 0.06;     ///< m: up after a release that another move follows
+  double path_peak_speed = 0.9;     ///< m/s, peak end-effector speed of a path's quintic timing
+  double max_node_speed = 0.9;      ///< m/s, planned peak speed of any rod node
+  int min_segment_steps = 60;       ///< shortest path, control steps
+  double settle_speed = 0.05;       ///< m/s: close / open only when every node is slower
+  double settle_error = 0.01;       ///< m: and the end-effector this near its pose
+  int max_settle_steps = 200;       ///< longest wait for settling (then act anyway)
+  double start_error = 0.015;       ///< m: a chained path starts once the previous one is this near
+  double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
+  int max_retries = 1;              ///< re-tries of a missed grasp
+};
+
+/// What the expert is doing.
+enum class ExpertPhase { approach, descend, close, carry, lower, open, retract, idle, failed };
+
+inline std::string_view to_string(ExpertPhase p) {
+  switch (p) {
+    case ExpertPhase::approach: return "approach";
+    case ExpertPhase::descend: return "descend";
+    case ExpertPhase::close: return "close";
+    case ExpertPhase::carry: return "carry";
+    case ExpertPhase::lower: return "lower";
+    case ExpertPhase::open: return "open";
+    case ExpertPhase::retract: return "retract";
+    case ExpertPhase::idle: return "idle";
+    case ExpertPhase::failed: return "failed";
+  }
+  return "?";
+}
+
+/// A waypoint reached (or a phase entered) at a control step.
+struct ExpertEvent {
+  long step = 0;
+  int move = 0;
+  ExpertPhase phase = ExpertPhase::approach;
+  Eigen::Vector3d position{Eigen::Vector3d::Zero()};  ///< end-effector position when it happened
+};
+
+class Expert {
+ public:
+  using Pose = math::Pose<double>;
+  using Vec3 = Eigen::Vector3d;
+  using Array3 = TaskEnv::Array3;
+  using Executor = TaskEnv::Executor;
+
+  explicit Expert(const TaskEnv& env, ExpertConfig config = {})
+      : env_(&env), config_(config), executor_(env.home_executor()), planner_(env.home_executor()) {
+    const int n = env.arm_model().rod.n_elements;
+    observation_ = control::make_arm_observation<double>(n, env.config().observe_stride);
+    events_.reserve(64);
+  }
+
+  /// Starts the episode of the env's current scene (call after env.reset()).
+  void reset() {
+    executor_ = env_->home_executor();
+    target_ = env_->home_pose();
+    move_ = 0;
+    retries_ = 0;
+    s_ = 0;
+    waited_ = 0;
+    steps_ = 0;
+    events_.clear();
+    failure_ = nullptr;
+    moves_ = count_moves();
+    begin_move();
+  }
+
+  /// The action of the next control step (torques n x 3 and gripper state S), from the env's
+  /// privileged state. Call once per env.step().
+  void act(Array3& torques, int& s) {
+    const auto& w = env_->world();
+    if (steps_ > 0) advance(w);
+    control::observe_arm(w, target_, observation_);
+    executor_.act(observation_, torques);
+    s = s_;
+    ++steps_;
+  }
+
+  ExpertPhase phase() const { return phase_; }
+  int move() const { return move_; }
+  int moves() const { return moves_; }
+  /// Why the expert gave up ("" while it has not): a path the executor refused, a missed grasp.
+  const char* failure() const { return failure_ ? failure_ : ""; }
+  const std::vector<ExpertEvent>& events() const { return events_; }
+  const Executor& executor() const { return executor_; }
+
+ private:
+  /// One move: the object, where it goes, and the end-effector waypoints. A leg is one or two
+  /// straight lines: direct, or "via" (approach: level to above the approach pose first; carry:
+  /// straight up by lift_height first, then level to above the place pose).
+  struct Plan {
+    int object = -1;
+    Pose object_target;  ///< asset frame -> world at release
+    Pose grasp, place;   ///< end-effector poses
+    bool via_approach = false, via_carry = false;
+    std::array<Pose, 2> approach_leg, carry_leg;
+    int approach_count = 1, carry_count = 1;
+  };
+
+  /// The approach leg from the end-effector pose `from` (the annotation's approach pose last).
+  void set_approach_leg(Plan& p, const Pose& approach, const Pose& from) const {
+    p.approach_count = 0;
+    if (p.via_approach) {
+      Pose above = approach;
+      above.translation.z() = std::max(approach.translation.z(), from.translation.z());
+      p.approach_leg[static_cast<std::size_t>(p.approach_count++)] = above;
+    }
+    p.approach_leg[static_cast<std::size_t>(p.approach_count++)] = approach;
+  }
+  /// The carry leg from the grasp to carry_height above the place pose.
+  void set_carry_leg(Plan& p) const {
+    Pose above = p.place;
+    above.translation.z() += config_.carry_height;
+    p.carry_count = 0;
+    if (p.via_carry) {
+      Pose lift = p.grasp;
+      lift.translation.z() += config_.lift_height;
+      above.translation.z() = std::max(above.translation.z(), lift.translation.z());
+      p.carry_leg[static_cast<std::size_t>(p.carry_count++)] = lift;
+    }
+    p.carry_leg[static_cast<std::size_t>(p.carry_count++)] = above;
+  }
+
+  int count_moves() const {
+    const auto& s = env_->spec();
+    switch (s.task) {
+      case scene::Task::coll:
+      case scene::Task::aln: return 1;
+      case scene::Task::stk: return static_cast<int>(s.goal.items.size()) - 1;
+      case scene::Task::arr: {
+        int n = 0;
+        for (const auto& r : s.goal.relations) n += static_cast<int>(r.spots.size());
+        return n;
+      }
+    }
+    return 0;
+  }
+
+  const assets::Asset& asset_of(int object) const {
+    return env_->library().get(env_->spec().objects.at(static_cast<std::size_t>(object)).asset_id, "expert object");
+  }
+  const ObjectState& state_of(int object) const { return env_->snapshot().objects[static_cast<std::size_t>(object)]; }
+
+  /// Move k: which object goes where (read from the current state).
+  std::pair<int, Pose> move_goal(int k) const {
+    const auto& s = env_->spec();
+    const double top = s.table.top_center.z();
+    switch (s.task) {
+      case scene::Task::coll: {
+        const Pose container = state_of(s.goal.container).pose;
+        const auto& rc = asset_of(s.goal.container).receptacles.at(0);
+        const Pose opening = container * rc.opening, placement = container * rc.placement;
+        Pose p = state_of(s.goal.object).pose;
+        p.translation = Vec3(placement.translation.x(), placement.translation.y(), opening.translation.z() + config_.place_clearance);
+        return {s.goal.object, p};
+      }
+      case scene::Task::aln: {
+        const Pose now = state_of(s.goal.object).pose;
+        Pose p = s.goal.goal_pose;
+        p.translation.z() += config_.place_clearance;
+        p.rotation = nearest_equivalent(now.rotation, p.rotation, s.goal.symmetry);
+        return {s.goal.object, p};
+      }
+      case scene::Task::stk: {
+        const int below = s.goal.items.at(static_cast<std::size_t>(k)), item = s.goal.items.at(static_cast<std::size_t>(k) + 1);
+        const Pose b = state_of(below).pose;
+        const auto& ab = asset_of(below);
+        Pose p = state_of(item).pose;
+        const Vec3 on = ab.receptacles.empty() ? Vec3(b.translation + Vec3(0, 0, scene::asset_height(ab))) : Vec3((b * ab.receptacles.front().placement).translation);
+        p.translation = on + Vec3(0, 0, config_.place_clearance);
+        return {item, p};
+      }
+      case scene::Task::arr: {
+        int n = 0;
+        for (const auto& r : s.goal.relations)
+          for (std::size_t j = 0; j < r.spots.size(); ++j, ++n)
+            if (n == k) {
+              const int o = r.objects.at(j);
+              Pose p = state_of(o).pose;
+              p.translation = Vec3(r.spots[j].x(), r.spots[j].y(), top + (p.translation.z() - top) + config_.place_clearance);
+              return {o, p};
+            }
+        break;
+      }
+    }
+    manisoft::detail::fail("Expert: no move ", k);
+  }
+
+  /// The goal orientation's symmetric equivalent that turns least from `now` (about world z).
+  static Eigen::Matrix3d nearest_equivalent(const Eigen::Matrix3d& now, const Eigen::Matrix3d& goal, const scene::Symmetry& sym) {
+    if (sym.kind == scene::Symmetry::Kind::axial) {
+      // only the axis matters: keep the current yaw, take the goal's axis (both upright here)
+      return now;
+    }
+    const int n = sym.kind == scene::Symmetry::Kind::discrete ? std::max(1, sym.order) : 1;
+    Eigen::Matrix3d best = goal;
+    double best_angle = 10;
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Matrix3d g = goal * Eigen::AngleAxisd(2 * std::numbers::pi * k / n, Vec3::UnitZ()).toRotationMatrix();
+      const double a = Eigen::AngleAxisd(g * now.transpose()).angle();
+      if (a < best_angle) best_angle = a, best = g;
+    }
+    return best;
+  }
+
+  /// Angle between an end-effector orientation and the home one.
+  double turn_from_home(const Pose& p) const { return Eigen::AngleAxisd(p.rotation * env_->home_pose().rotation.transpose()).angle(); }
+
+  /// The grasp of move k: the feasible candidate that turns least (see the header comment).
+  bool plan_move(int k) {
+    const auto [object, target] = move_goal(k);
+    const auto& a = asset_of(object);
+    const Pose now = state_of(object).pose;
+    const double top = env_->spec().table.top_center.z();
+    struct Candidate {
+      double cost;
+      Plan plan;
+    };
+    std::vector<Candidate> candidates;
+    const Pose from = executor_.statics().desired_tip_pose();
+    for (const auto& g : a.grasps) {
+      for (int flip = 0; flip < 2; ++flip) {
+        Pose turn;
+        turn.rotation = Eigen::AngleAxisd(flip * std::numbers::pi, Vec3::UnitZ()).toRotationMatrix();
+        for (int variant = 0; variant < 4; ++variant) {
+          Plan p;
+          p.object = object;
+          p.object_target = target;
+          p.grasp = now * g.grasp * turn;
+          p.place = target * now.inverse() * p.grasp;
+          p.via_approach = variant & 1;
+          p.via_carry = variant & 2;
+          set_approach_leg(p, now * g.approach * turn, from);
+          set_carry_leg(p);
+          // least turning first, then the fewest lines
+          const double cost = std::max(turn_from_home(p.grasp), turn_from_home(p.place)) + 1e-3 * variant;
+          candidates.push_back({cost, p});
+        }
+      }
+    }
+    std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
+    plan_refusal_ = candidates.empty() ? "the asset has no grasp annotation" : "";
+    for (const auto& c : candidates) {
+      planner_ = executor_;
+      planner_.complete_path();
+      std::array<Pose, 6> seq;
+      std::array<const char*, 6> names{};
+      int n = 0;
+      for (int i = 0; i < c.plan.approach_count; ++i) names[n] = "approach", seq[n++] = c.plan.approach_leg[i];
+      names[n] = "grasp", seq[n++] = c.plan.grasp;
+      const int carry_from = n;
+      for (int i = 0; i < c.plan.carry_count; ++i) names[n] = "carry", seq[n++] = c.plan.carry_leg[i];
+      names[n] = "place", seq[n++] = c.plan.place;
+      bool ok = true;
+      for (int i = 0; i < n && ok; ++i) {
+        if (i == carry_from) planner_.set_payload(a.mass, c.plan.grasp.rotation.transpose() * (now.act(a.center_of_mass) - c.plan.grasp.translation));
+        const auto report = planner_.track_line(seq[i], 100);
+        planner_.complete_path();
+        if (!report.accepted) {
+          ok = false;
+          if (plan_refusal_.empty()) plan_refusal_ = std::string(names[i]) + ": " + report.reason;
+        } else if (planner_.statics().desired_state().positions.col(2).minCoeff() < top + config_.table_clearance) {
+          ok = false;
+          if (plan_refusal_.empty()) plan_refusal_ = std::string(names[i]) + ": the arm would touch the table";
+        }
+      }
+      if (ok) {
+        plan_ = c.plan;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void begin_move() {
+    waited_ = 0;
+    if (move_ >= moves_) {
+      enter(ExpertPhase::idle);
+      return;
+    }
+    if (!plan_move(move_)) {
+      plan_refusal_ = "no feasible grasp (the least-turning one: " + plan_refusal_ + ")";
+      give_up(plan_refusal_.c_str());
+      return;
+    }
+    leg_ = 0;
+    enter(ExpertPhase::approach);
+    start_path(plan_.approach_leg[0]);
+  }
+
+  void enter(ExpertPhase p) {
+    phase_ = p;
+    if (events_.size() < events_.capacity()) {
+      ExpertEvent e;
+      e.step = steps_;
+      e.move = move_;
+      e.phase = p;
+      e.position = env_->world().soft().end_effector_frame().position;
+      events_.push_back(e);
+    }
+  }
+  void give_up(const char* why) {
+    failure_ = why;
+    enter(ExpertPhase::failed);
+  }
+
+  bool start_path(const Pose& goal) {
+    const double distance = (goal.translation - executor_.statics().desired_tip_pose().translation).norm();
+    const double control_dt = env_->control_dt();
+    const int steps = std::max(config_.min_segment_steps, static_cast<int>(std::ceil(1.875 * distance / config_.path_peak_speed / control_dt)));
+    const auto report = executor_.track_line(goal, steps, config_.max_node_speed * control_dt);
+    if (!report.accepted) {
+      give_up(report.reason);
+      return false;
+    }
+    target_ = goal;
+    return true;
+  }
+
+  /// The phase machine, after the last control step.
+  void advance(const TaskEnv::World& w) {
+    const auto f = w.soft().end_effector_frame();
+    const double error = (f.position - target_.translation).norm();
+    const double speed = w.rod().state().velocities.rowwise().norm().maxCoeff();
+    const bool done = executor_.path_done();
+    const bool settled = done && speed < config_.settle_speed && error < config_.settle_error;
+    const auto held = w.gripper().held();
+    const bool holding = held && plan_.object >= 0 && *held == env_->bodies().objects[static_cast<std::size_t>(plan_.object)];
+    switch (phase_) {
+      case ExpertPhase::approach:
+        if (done && error < config_.start_error) {
+          if (++leg_ < plan_.approach_count) {
+            start_path(plan_.approach_leg[static_cast<std::size_t>(leg_)]);
+          } else {
+            enter(ExpertPhase::descend);
+            start_path(plan_.grasp);
+          }
+        }
+        break;
+      case ExpertPhase::descend:
+        if (done && (settled || ++waited_ > config_.max_settle_steps)) {
+          waited_ = 0;
+          s_ = 1;
+          enter(ExpertPhase::close);
+        }
+        break;
+      case ExpertPhase::close: {
+        if (!holding) {
+          s_ = 0;
+          if (retries_++ < config_.max_retries) {
+            begin_move();
+          } else {
+            give_up("missed grasp");
+          }
+          break;
+        }
+        // Where the object sits in the hand: the payload hint and the place correction.
+        const Pose ee{f.rotation, f.position};
+        const Pose object = state_of(plan_.object).pose;
+        const auto& a = asset_of(plan_.object);
+        executor_.set_payload(a.mass, ee.rotation.transpose() * (object.act(a.center_of_mass) - ee.translation));
+        plan_.place = plan_.object_target * object.inverse() * ee;
+        set_carry_leg(plan_);
+        leg_ = 0;
+        enter(ExpertPhase::carry);
+        start_path(plan_.carry_leg[0]);
+        break;
+      }
+      case ExpertPhase::carry:
+        if (!holding) {
+          give_up("dropped the object");
+          break;
+        }
+        if (done && error < config_.start_error) {
+          if (++leg_ < plan_.carry_count) {
+            start_path(plan_.carry_leg[static_cast<std::size_t>(leg_)]);
+          } else {
+            enter(ExpertPhase::lower);
+            start_path(plan_.place);
+          }
+        }
+        break;
+      case ExpertPhase::lower:
+        if (!holding) {
+          give_up("dropped the object");
+          break;
+        }
+        if (done && (settled || ++waited_ > config_.max_settle_steps)) {
+          waited_ = 0;
+          s_ = 0;
+          executor_.set_payload(0.0);
+          enter(ExpertPhase::open);
+        }
+        break;
+      case ExpertPhase::open:
+        ++move_;
+        retries_ = 0;
+        if (move_ < moves_) {
+          Pose up = plan_.place;
+          up.translation.z() += config_.retract_height;
+          enter(ExpertPhase::retract);
+          start_path(up);
+        } else {
+          enter(ExpertPhase::idle);
+        }
+        break;
+      case ExpertPhase::retract:
+        if (done && error < config_.start_error) begin_move();
+        break;
+      case ExpertPhase::idle:
+      case ExpertPhase::failed: break;
+    }
+  }
+
+  const TaskEnv* env_;
+  ExpertConfig config_;
+  Executor executor_, planner_;
+  control::Observation<double> observation_;
+  Pose target_;
+  Plan plan_;
+  ExpertPhase phase_ = ExpertPhase::idle;
+  int move_ = 0, moves_ = 0, retries_ = 0, s_ = 0, waited_ = 0, leg_ = 0;
+  long steps_ = 0;
+  std::vector<ExpertEvent> events_;
+  const char* failure_ = nullptr;
+  std::string plan_refusal_;  ///< why the least-turning grasp candidate was refused
+};
+
+}  // namespace manisoft::task

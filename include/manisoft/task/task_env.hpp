@@ -1,0 +1,337 @@
+// The task environment of the four ManiSoft tasks (paper sections 3.2 and 3.4; issue 13): one
+// scene (scene::SceneSpec) in the one arm world (world::ArmWorld on the tabletop), stepped one
+// control step at a time through the actuation limits, with the task's success predicate
+// (task/success.hpp) judged after every step.
+//
+//   task::TaskEnv env(library);          // builds the arm and brings it home once
+//   env.reset(spec);                     // the scene's bodies, the arm at home, step 0
+//   while (!env.done()) env.step(torques, S);   // torques n x 3 (material frame), S 0 open / 1 closed
+//
+// Control step: 7 substeps of 2e-4 s (714 Hz), horizon 1500 control steps (the paper's T).
+// Home: every episode starts from the same settled arm, tool-down with the gripper's grasp centre
+// at `home` (high above the reachable band, so it is clear of every scene's objects), reached once
+// from the straight arm by the model executor's shape ramp and then held; the arm's state is
+// saved and restored at each reset (those steps are not the episode's).
+// Success: the predicate holds (released and at rest included) for `hold_steps` consecutive
+// control steps; the episode ends at the first such step (success once) and `success_at_end()`
+// says whether it still held at the last step (ManiSkill reports both).
+// Failure reasons (FailureReason): scene_invalid (an ALN or ARR goal holds already at reset: no
+// task; the episode ends before its first step), diverged (the step was refused: the world is as before it, the
+// episode ends), object_off_table (a scene object left the table top: ends the episode),
+// arm_hit_obstacle (the rod or the gripper touched an obstacle at some step; the episode goes on,
+// the reason is reported if it does not succeed), object_dropped (a held object slipped or was
+// released away from the goal and the episode timed out), timeout.
+// No heap allocation in step() once reset() has sized everything.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "manisoft/control/arm_observation.hpp"
+#include "manisoft/control/model_executor.hpp"
+#include "manisoft/core/error.hpp"
+#include "manisoft/rod/cosserat_rod.hpp"
+#include "manisoft/rod/inverse_statics.hpp"
+#include "manisoft/scene/asset_library.hpp"
+#include "manisoft/scene/scene_spec.hpp"
+#include "manisoft/scene/scene_world.hpp"
+#include "manisoft/task/success.hpp"
+#include "manisoft/world/arm_world.hpp"
+#include "manisoft/world/tabletop_scene.hpp"
+
+namespace manisoft::task {
+
+struct TaskEnvConfig {
+  double dt = 2e-4;          ///< s, substep
+  int substeps = 7;          ///< per control step (714 Hz)
+  int horizon = 1500;        ///< control steps (the paper's T)
+  double rod_damping = 0.1;  ///< analytical linear damping of the simulated rod
+  Eigen::Vector3d home{0.50, 0.0, 0.88};  ///< grasp centre of the home pose (tool down, yaw 0), m
+  int home_path_steps = 900;              ///< control steps of the straight arm's ramp home
+  int home_settle_steps = 300;            ///< then held
+  int hold_steps = 10;                    ///< control steps the predicate must hold for success
+  int observe_stride = 2;                 ///< every this many nodes in the executor's observation
+  Tolerances tolerances{};
+  control::ModelExecutorSettings<double> executor{};
+};
+
+/// What one control step reports.
+struct StepInfo {
+  long step = 0;         ///< control steps taken in this episode
+  bool success = false;  ///< reached at this step or before
+  bool done = false;     ///< success, horizon or a terminal failure
+  FailureReason failure = FailureReason::none;  ///< set once done without success
+  int clamped = 0;       ///< torque entries clamped to the actuation limits this step
+};
+
+class TaskEnv {
+ public:
+  using Rod = rod::CosseratRod<double, rod::damping::AnalyticalLinear, rod::bc::ClampedBase, rod::integrator::PositionVerlet,
+                               rod::forcing::Gravity, rod::forcing::ElementTorques>;
+  using World = world::ArmWorld<Rod>;
+  using Pose = math::Pose<double>;
+  using Vec3 = Eigen::Vector3d;
+  using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+  using Executor = control::ModelExecutor<double>;
+
+  explicit TaskEnv(const scene::AssetLibrary& library, TaskEnvConfig config = {})
+      : library_(&library), config_(validated(config)), params_(world::tabletop_arm_parameters()),
+        model_(rod::make_arm_model(params_, gripper_.mass)), executor_(model_, world_settings().limits, config_.executor) {
+    go_home();
+  }
+
+  // ---- episode
+  /// Builds the scene's bodies around the arm at home; step 0. A spec whose table geometry or
+  /// mount differs from the world's is refused (only its looks may vary).
+  void reset(const scene::SceneSpec& spec) {
+    const world::TableDesc t = spec.table.desc(), home_table = scene::TableSpec{}.desc();
+    if ((t.top_center - home_table.top_center).norm() > 1e-12 || t.half_x != home_table.half_x || t.half_y != home_table.half_y ||
+        t.thickness != home_table.thickness)
+      manisoft::detail::fail("TaskEnv::reset: the scene's table (top centre ", t.top_center.transpose(), ", half extents ", t.half_x, " x ", t.half_y,
+                             ") differs from the world's (", home_table.top_center.transpose(), ", ", home_table.half_x, " x ", home_table.half_y, ")");
+    if (static_cast<int>(spec.objects.size()) > max_objects)
+      manisoft::detail::fail("TaskEnv::reset: ", spec.objects.size(), " objects, at most ", max_objects);
+    spec_ = spec;
+    world_.reset();
+    world_.emplace(make_rod(), world_settings());
+    World& w = *world_;
+    w.add_table(t);
+    w.soft().restore(home_snapshot_);  // the arm, the gripper, the table and the floor
+    bodies_ = scene::populate_objects(w, spec_, *library_);
+    bodies_.table = w.table();
+    object_of_body_.assign(w.rigid().body_count(), -1);
+    obstacle_body_.assign(w.rigid().body_count(), 0);
+    for (std::size_t i = 0; i < bodies_.objects.size(); ++i) object_of_body_[bodies_.objects[i]] = static_cast<int>(i);
+    for (const auto b : bodies_.obstacles) obstacle_body_[b] = 1;
+    states_.assign(spec_.objects.size(), ObjectState{});
+    receptacle_ = spec_.task == scene::Task::coll ? container_receptacle() : assets::Receptacle{};
+    relations_.clear();
+    for (const auto& r : spec_.goal.relations) relations_.push_back(to_task_relation(r));
+    tracker_ = SuccessTracker(config_.hold_steps);
+    info_ = StepInfo{};
+    touched_obstacle_ = false;
+    dropped_ = false;
+    last_event_step_ = 0;
+    update_states();
+    // A goal that holds before any action is no task: the scene is invalid (the episode ends).
+    // Contacts are known only after a step, so this catches the position-only goals (ALN, ARR).
+    if (predicate()) finish(FailureReason::scene_invalid);
+  }
+
+  /// One control step: element torques (n x 3, material frame; clamped to the actuation limits)
+  /// and gripper state S (0 open, 1 closed). Non-finite or ill-shaped input is refused naming the
+  /// entry before anything changes; stepping a finished episode is refused.
+  template <typename Matrix>
+  const StepInfo& step(const Matrix& torques, int s) {
+    if (!world_) manisoft::detail::fail("TaskEnv::step: call reset() first");
+    if (info_.done) manisoft::detail::fail("TaskEnv::step: the episode is over (step ", info_.step, "); call reset()");
+    World& w = *world_;
+    try {
+      info_.clamped = w.control_step(torques, s, [this] { note_obstacle_contacts(); });
+    } catch (const Diverged&) {
+      return finish(FailureReason::diverged);
+    }
+    ++info_.step;
+    for (const auto& e : w.events())
+      if (e.step > last_event_step_ && e.kind == world::WorldEvent::Kind::slipped) dropped_ = true;
+    last_event_step_ = w.step_count();
+    update_states();
+    if (tracker_.update(info_.step, predicate())) {
+      info_.success = true;
+      info_.done = true;
+      return info_;
+    }
+    for (const auto b : bodies_.objects)
+      if (w.is_off_table(b)) return finish(FailureReason::object_off_table);
+    if (info_.step >= config_.horizon) {
+      return finish(touched_obstacle_ ? FailureReason::arm_hit_obstacle : dropped_ ? FailureReason::object_dropped : FailureReason::timeout);
+    }
+    return info_;
+  }
+
+  // ---- state
+  const StepInfo& info() const { return info_; }
+  bool done() const { return info_.done; }
+  /// Whether the predicate held at the last step (ManiSkill's "success at end").
+  bool success_at_end() const { return tracker_.holds_now(); }
+  bool touched_obstacle() const { return touched_obstacle_; }
+  /// The predicates' view of the current step (objects as in the spec).
+  Snapshot snapshot() const {
+    return Snapshot{std::span<const ObjectState>(states_.data(), states_.size()), world_ ? world_->gripper().state() == 0 : true};
+  }
+  const scene::SceneSpec& spec() const { return spec_; }
+  const scene::SceneBodies& bodies() const { return bodies_; }
+  const World& world() const {
+    if (!world_) manisoft::detail::fail("TaskEnv::world: call reset() first");
+    return *world_;
+  }
+  const scene::AssetLibrary& library() const { return *library_; }
+  const TaskEnvConfig& config() const { return config_; }
+  /// The model executor that brought the arm home (its internal state matches the home arm): an
+  /// expert starts each episode from a copy.
+  const Executor& home_executor() const { return home_executor_; }
+  /// The home pose (end-effector frame) and the tool-down pose with grasp centre `c`, yaw `yaw`.
+  Pose home_pose() const { return tool_down(config_.home, 0.0); }
+  Pose tool_down(const Vec3& grasp_center, double yaw) const {
+    Eigen::Matrix3d down;
+    down << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // d1 = +x, d2 = -y, d3 = -z
+    Pose p;
+    p.rotation = Eigen::AngleAxisd(yaw, Vec3::UnitZ()).toRotationMatrix() * down;
+    p.translation = grasp_center - p.rotation * gripper_.grasp_center();
+    return p;
+  }
+  const interaction::ParallelGripperParameters& gripper_parameters() const { return gripper_; }
+  const rod::ArmModel<double>& arm_model() const { return model_; }
+  double control_dt() const { return config_.dt * config_.substeps; }
+  /// Control steps of the reset from the straight arm to home (once, not part of episodes).
+  int home_steps() const { return config_.home_path_steps + config_.home_settle_steps; }
+
+ private:
+  static TaskEnvConfig validated(const TaskEnvConfig& c) {
+    manisoft::detail::require_positive("TaskEnvConfig dt", c.dt);
+    if (c.substeps < 1) manisoft::detail::fail("TaskEnvConfig substeps = ", c.substeps, " must be >= 1");
+    if (c.horizon < 1) manisoft::detail::fail("TaskEnvConfig horizon = ", c.horizon, " must be >= 1");
+    if (c.hold_steps < 1) manisoft::detail::fail("TaskEnvConfig hold_steps = ", c.hold_steps, " must be >= 1");
+    if (c.home_path_steps < 1) manisoft::detail::fail("TaskEnvConfig home_path_steps = ", c.home_path_steps, " must be >= 1");
+    manisoft::detail::require_non_negative("TaskEnvConfig rod_damping", c.rod_damping);
+    if (!c.home.allFinite()) manisoft::detail::fail("TaskEnvConfig home is not finite");
+    return c;
+  }
+  world::ArmWorldSettings world_settings() const {
+    world::ArmWorldSettings s;
+    s.gripper = gripper_;
+    s.substeps_per_control_step = config_.substeps;
+    return s;
+  }
+  Rod make_rod() const { return Rod(params_, config_.dt, rod::damping::AnalyticalLinear<double>(config_.rod_damping)); }
+
+  /// From the straight arm to home in a world with only the table: saved as every episode's start.
+  void go_home() {
+    world_.emplace(make_rod(), world_settings());
+    world_->add_table(scene::TableSpec{}.desc());
+    const Pose home = home_pose();
+    const auto solved = executor_.set_target(home);
+    if (!solved.within_limits)
+      manisoft::detail::fail("TaskEnv: the home pose (grasp centre ", config_.home.transpose(), ") is not held within the actuation limits (torque ratio ",
+                             solved.max_torque_ratio, ")");
+    auto observation = control::make_arm_observation<double>(params_.n_elements, config_.observe_stride);
+    Array3 torques = Array3::Zero(params_.n_elements, 3);
+    for (int i = 0; i < home_steps(); ++i) {
+      control::observe_arm(*world_, home, observation);
+      executor_.act(observation, torques);
+      world_->control_step(torques, 0);
+    }
+    world_->soft().save(home_snapshot_);
+    home_executor_ = executor_;
+    world_.reset();
+  }
+
+  assets::Receptacle container_receptacle() const {
+    const auto& c = spec_.objects.at(static_cast<std::size_t>(spec_.goal.container));
+    const auto& a = library_->get(c.asset_id, "COLL container");
+    if (a.receptacles.empty()) manisoft::detail::fail("TaskEnv::reset: the COLL container ", c.asset_id, " has no receptacle annotation");
+    return a.receptacles.front();
+  }
+  static Relation to_task_relation(const scene::Relation& r) {
+    Relation t;
+    t.kind = static_cast<Relation::Kind>(static_cast<int>(r.kind));  // the same enumerators in the same order
+    std::size_t k = 0;
+    for (int i : r.objects) t.objects.at(k++) = i;
+    for (int i : r.references) t.objects.at(k++) = i;
+    return t;
+  }
+
+  bool predicate() const {
+    const Snapshot s = snapshot();
+    const auto& g = spec_.goal;
+    const auto& tol = config_.tolerances;
+    switch (spec_.task) {
+      case scene::Task::coll: return collected(s, g.object, g.container, receptacle_, tol);
+      case scene::Task::aln: {
+        const Symmetry sym{static_cast<Symmetry::Kind>(static_cast<int>(g.symmetry.kind)), g.symmetry.order};
+        return aligned(s, g.object, g.goal_pose, sym, tol);
+      }
+      case scene::Task::stk: return stacked(s, g.items, tol);
+      case scene::Task::arr: return arranged(s, relations_, tol);
+    }
+    return false;
+  }
+
+  void update_states() {
+    const World& w = *world_;
+    const auto& rigid = w.rigid();
+    const auto held = w.gripper().held();
+    for (std::size_t i = 0; i < states_.size(); ++i) {
+      const rigid::BodyId b = bodies_.objects[i];
+      ObjectState& o = states_[i];
+      o.pose.rotation = rigid.orientation(b).toRotationMatrix();
+      o.pose.translation = rigid.position(b);
+      o.center_of_mass = rigid.center_of_mass(b);
+      o.linear_velocity = rigid.linear_velocity(b);
+      o.angular_velocity = rigid.angular_velocity(b);
+      o.touches_table = false;
+      o.touching = 0;
+      o.held = held && *held == b;
+    }
+    for (const auto& m : rigid.manifolds()) {
+      bool touching = false;
+      for (int k = 0; k < m.count; ++k) touching = touching || m.points[static_cast<std::size_t>(k)].separation <= contact_margin;
+      if (!touching) continue;
+      const int a = object_of_body_[m.body_a], b = object_of_body_[m.body_b];
+      if (a >= 0 && b >= 0) {
+        states_[static_cast<std::size_t>(a)].touching |= std::uint64_t(1) << b;
+        states_[static_cast<std::size_t>(b)].touching |= std::uint64_t(1) << a;
+      }
+      if (a >= 0 && m.body_b == bodies_.table) states_[static_cast<std::size_t>(a)].touches_table = true;
+      if (b >= 0 && m.body_a == bodies_.table) states_[static_cast<std::size_t>(b)].touches_table = true;
+    }
+  }
+  /// After each substep: did the rod or the gripper touch an obstacle?
+  void note_obstacle_contacts() {
+    if (touched_obstacle_) return;
+    const World& w = *world_;
+    for (const auto& c : w.rod_contact().contacts())
+      if (c.separation <= 0 && obstacle_body_[c.body]) touched_obstacle_ = true;
+    const rigid::BodyId g = w.gripper_body();
+    for (const auto& m : w.rigid().manifolds()) {
+      if (m.count == 0 || (m.body_a != g && m.body_b != g)) continue;
+      const rigid::BodyId other = m.body_a == g ? m.body_b : m.body_a;
+      if (obstacle_body_[other]) touched_obstacle_ = true;
+    }
+  }
+  const StepInfo& finish(FailureReason reason) {
+    info_.done = true;
+    info_.failure = reason;
+    return info_;
+  }
+
+  static constexpr double contact_margin = 1e-3;  ///< m: closer than this counts as touching
+
+  const scene::AssetLibrary* library_;
+  TaskEnvConfig config_;
+  interaction::ParallelGripperParameters gripper_{};
+  rod::RodParameters<double> params_;
+  rod::ArmModel<double> model_;
+  Executor executor_;
+  Executor home_executor_{executor_};
+  std::optional<World> world_;
+  World::Soft::Snapshot home_snapshot_;
+  scene::SceneSpec spec_;
+  scene::SceneBodies bodies_;
+  std::vector<int> object_of_body_;
+  std::vector<char> obstacle_body_;
+  std::vector<ObjectState> states_;
+  assets::Receptacle receptacle_;
+  std::vector<Relation> relations_;
+  SuccessTracker tracker_{1};
+  StepInfo info_;
+  bool touched_obstacle_ = false, dropped_ = false;
+  long last_event_step_ = 0;
+};
+
+}  // namespace manisoft::task
