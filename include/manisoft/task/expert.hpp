@@ -18,8 +18,9 @@
 // actuation limits, the payload included) and whose waypoint shapes keep every rod node
 // table_clearance above the table top.
 // Waypoints of a move (the end-effector frame; straight lines with quintic timing,
-// ModelExecutor::track_line): approach (the annotation's), grasp, close once settled, carry
-// (above the place pose, diagonal from the grasp), place (corrected for where the object sits in
+// ModelExecutor::track_line): approach (the annotation's; "via": first level to above it),
+// grasp, close once settled, carry (above the place pose, diagonal from the grasp; "via": first
+// straight up by lift_height), place (corrected for where the object sits in
 // the hand, measured when it is held), open once settled, then up by retract_height when another
 // move follows. A missed grasp re-opens and retries the move from its approach (max_retries).
 // Deterministic; allocation only when a move is planned (path set-ups copy the executor).
