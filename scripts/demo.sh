@@ -1,16 +1,21 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds the examples in Release and runs the main demo: the tabletop
-# world (world_demo: the soft arm grasps the cube, carries it and puts it down within the
-# actuation limits) and its pictures (render_scene: the first frame and an image strip of the
-# episode through the in-process OpenGL renderer). Output in build/demo/.
+# Installs what is missing, builds the examples in Release and runs the benchmark's main job: one
+# expert episode of a ManiSoft task (run_task: the scene sampled, its instruction, each waypoint
+# as the expert reaches it, success and steps, one JSON line), then its pictures through the
+# in-process OpenGL renderer (render_scene: the first and the last frame, an image strip of the
+# episode). Choose another episode with TASK, SETTING, INDEX, SEED. Output in build/demo/.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+task=${TASK:-COLL} setting=${SETTING:-clean} index=${INDEX:-3} seed=${SEED:-0}
 bash "$root/scripts/install_deps.sh"
 cmake -S "$root" -B "$root/build/release" -DCMAKE_BUILD_TYPE=Release -DMANISOFT_BUILD_TESTS=OFF -DMANISOFT_BUILD_BENCHMARKS=OFF
-cmake --build "$root/build/release" --target world_demo render_scene -j2
+cmake --build "$root/build/release" --target run_task render_scene -j2
 out="$root/build/demo"
+rm -rf "$out"
 mkdir -p "$out"
-"$root/build/release/examples/world_demo" --out "$out/world_trace.csv"
-"$root/build/release/examples/render_scene" --trace "$out/world_trace.csv" --frame 2900 --out "$out"
-"$root/build/release/examples/render_scene" --trace "$out/world_trace.csv" --episode --every 700 --out "$out"
-echo "pictures: $out/rgb.png (the cube held and carried; depth.png, mask.png, camera.json beside it), $out/strip.png (the episode), $out/frames/"
+bin="$root/build/release/examples"
+"$bin/run_task" --task "$task" --setting "$setting" --index "$index" --seed "$seed" --save-scene "$out/scene.json" --trace "$out/trace.csv"
+"$bin/render_scene" --scene "$out/scene.json" --trace "$out/trace.csv" --frame 0 --out "$out/first"
+"$bin/render_scene" --scene "$out/scene.json" --trace "$out/trace.csv" --frame -1 --out "$out/last"
+"$bin/render_scene" --scene "$out/scene.json" --trace "$out/trace.csv" --episode --every 50 --out "$out/episode"
+echo "pictures: $out/first/rgb.png, $out/last/rgb.png (depth.png, mask.png, camera.json beside each), $out/episode/strip.png"

@@ -1,23 +1,23 @@
 // run_task: one expert episode of a ManiSoft task (include/manisoft/task/: TaskEnv + Expert).
 //   run_task --task COLL|ALN|STK|ARR --setting clean|randomized --index I --seed S
-//            [--split train|eval] [--scene scene.json] [--trace out.csv] [--quiet]
+//            [--split train|eval] [--scene scene.json] [--save-scene out.json] [--trace out.csv] [--quiet]
 // Samples the scene (or reads --scene), prints the instruction and each waypoint as it is
 // reached, and ends its output with one line of JSON:
 //   {"task":..., "setting":..., "index":..., "seed":..., "success":true|false, "steps":N,
 //    "failure":null|"reason", "expert":null|"why it gave up", "cpu_s":...}
-// --trace writes one CSV row per control step (step, phase, S, end-effector position, the goal
-// objects' positions). Exit 0 whether or not the episode succeeds; 1 on an error (a malformed
-// scene file, no valid scene), 2 on bad flags.
+// --trace writes one CSV row per control step, step 0 the state after reset, in world_demo's layout
+// (render_scene --scene S --trace T replays it): step, time, phase (the expert's phase: 0 approach,
+// 1 descend, 2 close, 3 carry, 4 lower, 5 open, 6 retract, 7 idle, 8 failed), S, finger width,
+// held (object index or -1), gripper pose (position, quaternion w x y z), every rod node, every
+// object's pose (object<i>_px..._qz). --save-scene writes the scene JSON. Exit 0 whether or not
+// the episode succeeds; 1 on an error (a malformed scene file, no valid scene), 2 on bad flags.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <ctime>
 #include <fstream>
-#include <map>
 #include <string>
 
-#include "manisoft/language/library.hpp"
-#include "manisoft/scene/scene_instructions.hpp"
 #include "manisoft/scene/scene_json.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/task/expert.hpp"
@@ -28,17 +28,23 @@ namespace task = manisoft::task;
 
 int main(int argc, char** argv) {
   CLI::App app{"Run the expert on one ManiSoft task episode"};
-  std::string task_name = "COLL", setting = "clean", split = "train", scene_file, trace_file;
+  std::string task_name = "COLL", setting = "clean", split = "train", scene_file, save_scene, trace_file;
   std::uint64_t index = 0, seed = 0;
   bool quiet = false;
+  task::ExpertConfig expert_config;
   app.add_option("--task", task_name, "COLL, ALN, STK or ARR")->check(CLI::IsMember({"COLL", "ALN", "STK", "ARR"}));
   app.add_option("--setting", setting, "clean or randomized")->check(CLI::IsMember({"clean", "randomized"}));
   app.add_option("--index", index, "scene index (>= 0)");
   app.add_option("--seed", seed, "dataset seed (>= 0)");
   app.add_option("--split", split, "train (default) or eval")->check(CLI::IsMember({"train", "eval"}));
   app.add_option("--scene", scene_file, "scene JSON to run instead of sampling one")->check(CLI::ExistingFile);
-  app.add_option("--trace", trace_file, "CSV file: one row per control step");
+  app.add_option("--save-scene", save_scene, "write the episode's scene JSON here");
+  app.add_option("--trace", trace_file, "CSV file: one row per control step (world_demo's layout)");
   app.add_flag("--quiet", quiet, "print only the JSON line");
+  app.add_option("--path-speed", expert_config.path_peak_speed, "expert: peak end-effector speed of a path with the gripper empty, m/s")->check(CLI::PositiveNumber);
+  app.add_option("--node-speed", expert_config.max_node_speed, "expert: planned peak speed of any rod node with the gripper empty, m/s")->check(CLI::PositiveNumber);
+  app.add_option("--carry-speed", expert_config.carry_peak_speed, "expert: peak end-effector speed while holding, m/s")->check(CLI::PositiveNumber);
+  app.add_option("--carry-node-speed", expert_config.carry_node_speed, "expert: planned peak node speed while holding, m/s")->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   try {
     const std::clock_t c0 = std::clock();
@@ -47,18 +53,17 @@ int main(int argc, char** argv) {
     if (!scene_file.empty()) {
       spec = scene::load_scene(scene_file, sampler.library());
     } else {
-      const std::map<std::string, scene::Task> tasks{{"COLL", scene::Task::coll}, {"ALN", scene::Task::aln}, {"STK", scene::Task::stk}, {"ARR", scene::Task::arr}};
       scene::SampleRequest q;
-      q.task = tasks.at(task_name);
-      q.setting = setting == "clean" ? scene::Setting::clean : scene::Setting::randomized;
-      q.split = split == "train" ? scene::Split::train : scene::Split::eval;
+      q.task = scene::parse_task(task_name);
+      q.setting = scene::parse_setting(setting);
+      q.split = scene::parse_split(split);
       q.index = index;
       q.seed = seed;
       spec = sampler.sample(q);
-      scene::describe(spec, sampler.library(), manisoft::language::Library::load_default(), seed);
     }
+    if (!save_scene.empty()) scene::save_scene(save_scene, spec);
     task::TaskEnv env(sampler.library());
-    task::Expert expert(env);
+    task::Expert expert(env, expert_config);
     const std::clock_t c1 = std::clock();
     env.reset(spec);
     expert.reset();
@@ -69,12 +74,37 @@ int main(int argc, char** argv) {
       std::printf("instruction: %s\n", spec.instruction.empty() ? "(none)" : spec.instruction.c_str());
     }
     std::ofstream trace;
+    auto write_row = [&](int phase, int s) {
+      const auto& w = env.world();
+      const auto& rigid = w.rigid();
+      const auto& objects = env.bodies().objects;
+      int held = -1;
+      for (std::size_t i = 0; i < objects.size(); ++i)
+        if (w.gripper().held() && *w.gripper().held() == objects[i]) held = static_cast<int>(i);
+      auto pose = [&](manisoft::rigid::BodyId b) {
+        const auto x = rigid.position(b);
+        const auto q = rigid.orientation(b);
+        trace << ',' << x.x() << ',' << x.y() << ',' << x.z() << ',' << q.w() << ',' << q.x() << ',' << q.y() << ',' << q.z();
+      };
+      trace << env.info().step << ',' << double(env.info().step) * env.control_dt() << ',' << phase << ',' << s << ',' << w.gripper().finger_width()
+            << ',' << held;
+      pose(w.gripper_body());
+      const auto& x = w.rod().state().positions;
+      for (int i = 0; i < x.rows(); ++i) trace << ',' << x(i, 0) << ',' << x(i, 1) << ',' << x(i, 2);
+      for (const auto b : objects) pose(b);
+      trace << '\n';
+    };
     if (!trace_file.empty()) {
       trace.open(trace_file);
       if (!trace) manisoft::detail::fail("run_task: cannot write ", trace_file);
-      trace << "step,phase,S,ee_x,ee_y,ee_z";
-      for (int i : scene::goal_objects(spec)) trace << ",obj" << i << "_x,obj" << i << "_y,obj" << i << "_z";
-      trace << "\n";
+      trace.precision(7);
+      trace << "step,time,phase,S,finger_width,held";
+      auto pose_columns = [&](const std::string& n) { trace << ',' << n << "_px," << n << "_py," << n << "_pz," << n << "_qw," << n << "_qx," << n << "_qy," << n << "_qz"; };
+      pose_columns("gripper");
+      for (int i = 0; i < env.world().rod().state().positions.rows(); ++i) trace << ",node" << i << "_x,node" << i << "_y,node" << i << "_z";
+      for (std::size_t i = 0; i < spec.objects.size(); ++i) pose_columns("object" + std::to_string(i));
+      trace << '\n';
+      write_row(static_cast<int>(expert.phase()), env.world().gripper().state());
     }
     task::TaskEnv::Array3 torques;
     int s = 0;
@@ -88,15 +118,7 @@ int main(int argc, char** argv) {
           std::printf("  step %4ld  move %d  %-8s  end-effector (%.3f, %.3f, %.3f)\n", e.step, e.move, std::string(task::to_string(e.phase)).c_str(),
                       e.position.x(), e.position.y(), e.position.z());
       }
-      if (trace.is_open()) {
-        const auto p = env.world().soft().end_effector_frame().position;
-        trace << env.info().step << ',' << task::to_string(expert.phase()) << ',' << s << ',' << p.x() << ',' << p.y() << ',' << p.z();
-        for (int i : scene::goal_objects(spec)) {
-          const auto& o = env.snapshot().objects[static_cast<std::size_t>(i)].center_of_mass;
-          trace << ',' << o.x() << ',' << o.y() << ',' << o.z();
-        }
-        trace << "\n";
-      }
+      if (trace.is_open()) write_row(static_cast<int>(expert.phase()), s);
     }
     if (trace.is_open()) {
       trace.close();

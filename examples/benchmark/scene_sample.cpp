@@ -2,13 +2,12 @@
 // its JSON (README "Scenes" has the schema):
 //   scene_sample --task COLL|ALN|STK|ARR --setting clean|randomized --index I --seed S
 //                [--split train|eval] --out scene.json
-// Prints the objects, obstacles and goal (scene::list_items) and the redraw count. Exit 2 on bad
+// Prints the objects, obstacles, instruction and goal (scene::list_items) and the redraw count. Exit 2 on bad
 // flags (CLI11 names the flag), 1 when no valid scene was found.
 #include <CLI/CLI.hpp>
 
 #include <chrono>
 #include <cstdio>
-#include <map>
 #include <string>
 
 #include "manisoft/scene/scene_json.hpp"
@@ -30,11 +29,10 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "print nothing on success");
   CLI11_PARSE(app, argc, argv);
   try {
-    const std::map<std::string, scene::Task> tasks{{"COLL", scene::Task::coll}, {"ALN", scene::Task::aln}, {"STK", scene::Task::stk}, {"ARR", scene::Task::arr}};
     scene::SampleRequest q;
-    q.task = tasks.at(task);
-    q.setting = setting == "clean" ? scene::Setting::clean : scene::Setting::randomized;
-    q.split = split == "train" ? scene::Split::train : scene::Split::eval;
+    q.task = scene::parse_task(task);
+    q.setting = scene::parse_setting(setting);
+    q.split = scene::parse_split(split);
     q.index = index;
     q.seed = seed;
     const auto t0 = std::chrono::steady_clock::now();
@@ -49,6 +47,7 @@ int main(int argc, char** argv) {
       for (const auto& it : scene::list_items(s))
         std::printf("  %-8s %2d  %-20s at (%.3f, %.3f, %.3f), yaw %.1f deg\n", it.kind == scene::PlacedItem::Kind::object ? "object" : "obstacle",
                     it.index, it.asset_id.c_str(), it.position.x(), it.position.y(), it.position.z(), it.yaw * 180 / 3.14159265358979323846);
+      std::printf("  instruction: %s (%zu seen + %zu unseen variants)\n", s.instruction.c_str(), s.instructions_seen.size(), s.instructions_unseen.size());
       std::printf("  goal objects:");
       for (int i : scene::goal_objects(s)) std::printf(" %d", i);
       std::printf("\nwrote %s\n", out.c_str());

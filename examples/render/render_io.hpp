@@ -91,7 +91,7 @@ inline math::Pose<double> pose_from(const Trace& t, std::size_t row, const std::
   return pose;
 }
 
-/// The built-in scene's frame for trace row `row`: rod nodes (frames derived from the centreline:
+/// The frame of trace row `row` (world_demo's built-in scene, or a spec scene replayed from run_task): rod nodes (frames derived from the centreline:
 /// the trace has no directors), gripper pose and opening, object poses.
 inline FrameState frame_from_trace(const tabletop::TabletopScene& scene, const Trace& t, std::size_t row) {
   if (row >= t.rows.size()) manisoft::detail::fail("trace: frame ", row, " is out of range: the trace has ", t.rows.size(), " rows (0..", t.rows.size() - 1, ")");
@@ -105,8 +105,11 @@ inline FrameState frame_from_trace(const tabletop::TabletopScene& scene, const T
     f.rod.nodes.row(i) << t.at(row, p + "_x"), t.at(row, p + "_y"), t.at(row, p + "_z");
   }
   tabletop::set_gripper(scene, f, pose_from(t, row, "gripper"), t.at(row, "finger_width"));
-  for (const auto& [name, instance] : scene.object_instance) {
-    if (t.has(name + "_px")) f.instance_poses[instance] = pose_from(t, row, name);
+  // every instance whose name's first word has pose columns (all parts of a multi-part asset)
+  for (std::size_t i = 0; i < scene.scene.instances.size(); ++i) {
+    const std::string& n = scene.scene.instances[i].name;
+    const std::string name = n.substr(0, n.find(' '));
+    if (t.has(name + "_px")) f.instance_poses[i] = pose_from(t, row, name);
   }
   return f;
 }

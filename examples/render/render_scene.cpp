@@ -1,4 +1,5 @@
-// render_scene: renders the built-in tabletop scene (or one frame of a world_demo trace) and
+// render_scene: renders the built-in tabletop scene or a scene JSON (--scene), optionally one frame
+// of a trace (world_demo's for the built-in scene, run_task's for its scene), and
 // writes rgb.png, depth.png (16-bit, mm), mask.png (object ids) and camera.json into --out.
 // With --episode it renders every --every-th trace row into DIR/frames/, an image strip
 // (strip.png) and, when ffmpeg is installed, DIR/episode.mp4.
@@ -54,12 +55,12 @@ std::vector<std::uint8_t> strip_image(const std::vector<RenderOutput>& frames, i
 int main(int argc, char** argv) {
   CLI::App app{"Render the ManiSoft tabletop scene: rgb.png, depth.png (16-bit mm), mask.png (ids), camera.json"};
   std::string scene_path, trace_path, renderer = "gl", out_dir, engine = "workbench";
-  std::size_t frame_index = 0;
+  long frame_arg = 0;
   int msaa = 0, every = 50, egl_device = -1, samples = 16;
   bool no_shadows = false, episode = false;
   app.add_option("--scene", scene_path, "scene JSON written by scene_sample (README \"Scenes\")");
-  app.add_option("--trace", trace_path, "world_demo CSV trace (README.md, \"world_demo\")");
-  app.add_option("--frame", frame_index, "trace row to render (0 = initial state)");
+  app.add_option("--trace", trace_path, "CSV trace: world_demo's (built-in scene) or run_task's (with its --scene)");
+  app.add_option("--frame", frame_arg, "trace row to render (0 = initial state; -1 the last row, -2 the one before, ...)");
   app.add_option("--renderer", renderer, "gl (in-process OpenGL, default) or blender")->check(CLI::IsMember({"gl", "blender"}));
   app.add_option("--out", out_dir, "output folder")->required();
   app.add_option("--msaa", msaa, "OpenGL multisampling: 0, 2, 4 or 8");
@@ -76,7 +77,6 @@ int main(int argc, char** argv) {
     tabletop::TabletopScene scene;
     if (!scene_path.empty()) {
 #if MANISOFT_RENDER_SCENES
-      if (!trace_path.empty()) manisoft::detail::fail("--trace replays world_demo's built-in scene: it cannot be combined with --scene ", scene_path);
       const manisoft::scene::AssetLibrary library;
       scene = spec::make_spec_scene(manisoft::scene::load_scene(scene_path, library), library);
 #else
@@ -87,6 +87,10 @@ int main(int argc, char** argv) {
     }
     io::Trace trace;
     if (!trace_path.empty()) trace = io::read_trace(trace_path);
+    const long row_count = static_cast<long>(trace.rows.size());
+    if (!trace_path.empty() && (frame_arg >= row_count || frame_arg < -row_count))
+      manisoft::detail::fail("--frame ", frame_arg, " is out of range: the trace has ", row_count, " rows (0..", row_count - 1, ", or -1..-", row_count, ")");
+    const std::size_t frame_index = static_cast<std::size_t>(frame_arg < 0 ? row_count + frame_arg : frame_arg);
     const fs::path out(out_dir);
     fs::create_directories(out);
 

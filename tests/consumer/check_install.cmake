@@ -17,3 +17,4 @@ run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/consumer" -B "${WORK_DIR}/app"
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/app")
 run("${WORK_DIR}/app/consumer")
 run("${WORK_DIR}/app/consumer_contact")
+run("${WORK_DIR}/app/consumer_scene")

@@ -327,6 +327,13 @@ TEST_CASE("asset symmetry and candidate grasps", "[scene]") {
   const auto drink = asset_symmetry(lib.get("box_drink/02", "t"));
   REQUIRE(drink.kind == Symmetry::Kind::discrete);
   REQUIRE(drink.order == 2);
+  // hollow lathes (a floor disc and rings of planks) are round; a basket (an open box) is 2-fold at most
+  for (const char* id : {"bowl/03", "plate/01", "cup/02", "pen_cup/00"}) {
+    INFO(id);
+    REQUIRE(asset_symmetry(lib.get(id, "t")).kind == Symmetry::Kind::axial);
+  }
+  REQUIRE(asset_symmetry(lib.get("basket/01", "t")).kind != Symmetry::Kind::axial);
+  REQUIRE(asset_symmetry(lib.get("shoe/01", "t")).kind == Symmetry::Kind::none);
   // a box asset: the annotated grasp and its half turn; a lathe asset: also the quarter turns
   math::Pose<double> at;
   at.translation = Eigen::Vector3d(0.4, 0.1, 0.75);

@@ -72,8 +72,30 @@ inline double footprint_radius(const assets::Asset& a) {
 /// Height of the asset's top above its origin (upright).
 inline double asset_height(const assets::Asset& a) { return a.bounding_center.z() + a.bounding_half_extents.z(); }
 
-/// The asset's symmetry about its z axis, read from its collision shape: one cylinder part ->
-/// axial; one box part -> 4-fold when its footprint is square, else 2-fold; anything else none.
+/// Whether a compound is a hollow lathe's (assets/catalog.hpp): a floor cylinder on the z axis,
+/// then rings of at least 8 equal parts, each ring's parts at one height and one distance from
+/// the axis, evenly spaced in angle.
+inline bool hollow_lathe_rings(const geometry::Compound<double>& c) {
+  const auto& floor = c.parts.front();
+  if (!std::holds_alternative<geometry::Cylinder<double>>(floor.shape) || floor.position.head<2>().norm() > 1e-9) return false;
+  std::size_t ring = 0;  // parts per ring: those at the first ring's height
+  while (1 + ring < c.parts.size() && std::abs(c.parts[1 + ring].position.z() - c.parts[1].position.z()) < 1e-12) ++ring;
+  if (ring < 8 || (c.parts.size() - 1) % ring != 0) return false;
+  for (std::size_t first = 1; first < c.parts.size(); first += ring) {
+    const Eigen::Vector3d p0 = c.parts[first].position;
+    for (std::size_t i = 0; i < ring; ++i) {
+      const Eigen::Vector3d p = c.parts[first + i].position;
+      const double angle = 2 * 3.14159265358979323846 * static_cast<double>(i) / static_cast<double>(ring);
+      const Eigen::Vector2d expected = Eigen::Rotation2Dd(angle) * p0.head<2>();
+      if (std::abs(p.z() - p0.z()) > 1e-9 || (p.head<2>() - expected).norm() > 1e-9) return false;
+    }
+  }
+  return true;
+}
+
+/// The asset's symmetry about its z axis, read from its collision shape: one cylinder part or a
+/// hollow lathe's rings -> axial; one box part -> 4-fold when its footprint is square, else
+/// 2-fold; anything else none.
 inline Symmetry asset_symmetry(const assets::Asset& a) {
   Symmetry s;
   auto from_box_or_cylinder = [&s](const auto& shape) {
@@ -86,7 +108,11 @@ inline Symmetry asset_symmetry(const assets::Asset& a) {
     }
   };
   if (const auto* c = std::get_if<geometry::Compound<double>>(&a.collision)) {
-    if (c->parts.size() != 1) return s;
+    if (c->parts.size() > 1) {
+      if (hollow_lathe_rings(*c)) s.kind = Symmetry::Kind::axial;
+      return s;
+    }
+    if (c->parts.empty()) return s;
     const auto& part = c->parts.front();
     const double yaw_free = std::abs(part.orientation.x()) + std::abs(part.orientation.y()) + std::abs(part.orientation.z());
     if (std::abs(part.position.x()) > 1e-9 || std::abs(part.position.y()) > 1e-9 || yaw_free > 1e-9) return s;

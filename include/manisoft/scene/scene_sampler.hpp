@@ -24,12 +24,16 @@
 #include <array>
 #include <cmath>
 #include <optional>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "manisoft/core/error.hpp"
+#include "manisoft/geometry/spatial_relation.hpp"
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/scene/reach_map.hpp"
+#include "manisoft/scene/scene_instructions.hpp"
 #include "manisoft/scene/scene_random.hpp"
 #include "manisoft/scene/scene_spec.hpp"
 #include "manisoft/scene/scene_validation.hpp"
@@ -68,6 +72,8 @@ struct SamplerSettings {
   double min_goal_distance = 0.12;  ///< m: an ALN goal / ARR spot this far from the start at least
   double relation_distance = 0.15;  ///< m between an ARR object and its reference
   double fit_clearance = 0.004;     ///< m: a COLL object is this much narrower than the opening
+  geometry::RelationTolerances relations;  ///< ARR: the success predicate's margins
+  double relation_margin = 0.02;    ///< m: the ARR spot holds with margins this much tighter, the start fails with them this much wider
   int min_obstacles = 3, max_obstacles = 10;
   ReachBand band;
   ValidationSettings validation;
@@ -83,7 +89,10 @@ struct SampleRequest {
 
 class SceneSampler {
  public:
-  explicit SceneSampler(SamplerSettings settings = {}) : settings_(settings), validator_(library_, settings.validation) {}
+  /// `language`: the instruction templates and descriptions (language::Library::load_default():
+  /// the shipped data files).
+  explicit SceneSampler(SamplerSettings settings = {}, language::Library language = language::Library::load_default())
+      : settings_(settings), validator_(library_, settings.validation), language_(std::move(language)) {}
   SceneSampler(const SceneSampler&) = delete;
   SceneSampler& operator=(const SceneSampler&) = delete;
 
@@ -91,7 +100,8 @@ class SceneSampler {
   SceneValidator& validator() { return validator_; }
   const SamplerSettings& settings() const { return settings_; }
 
-  /// The scene of `request`: the first valid draw (SceneSpec::sampling counts the redraws).
+  /// The scene of `request`: the first valid draw whose goal objects can all be named uniquely,
+  /// with its instructions (scene_instructions.hpp); SceneSpec::sampling counts the redraws.
   SceneSpec sample(const SampleRequest& q) {
     std::vector<std::string> rejections;
     for (int attempt = 0; attempt < settings_.max_attempts; ++attempt) {
@@ -100,13 +110,16 @@ class SceneSampler {
       std::string why = "placement failed";
       if (s) {
         const ValidationResult v = validator_.check(*s);
-        if (v.valid) {
+        if (!v.valid) {
+          why = v.reason;
+        } else if (!describe(*s, library_, language_, es)) {
+          why = "ambiguous: a goal object has no unique referring expression";
+        } else {
           s->sampling.engine_seed = es;
           s->sampling.redraws = attempt;
           s->sampling.rejections = rejections;
           return *std::move(s);
         }
-        why = v.reason;
       }
       rejections.push_back(why.substr(0, why.find(':')));
     }
@@ -252,12 +265,16 @@ class SceneSampler {
     return static_cast<int>(s.obstacles.size()) == n;
   }
 
-  /// Whether `obj` fits through the opening of `container` (round: its footprint circle; square:
-  /// its larger side) with `fit_clearance` to spare.
+  /// Whether `obj` fits into `container` with `fit_clearance` to spare. Square openings (a
+  /// basket's straight walls): its larger side. Round ones (a bowl flares from its floor to the
+  /// rim): its footprint circle passes the rim (the outer radius less the clearance, which covers
+  /// the wall) and, standing on the floor, its centre of mass stays below the rim, inside the COLL
+  /// predicate's inner volume.
   bool fits(const assets::Asset& obj, const assets::Asset& container) const {
     if (container.receptacles.empty()) return false;
     const auto& r = container.receptacles.front();
-    if (r.inner_radius > 0) return 2 * footprint_radius(obj) <= 2 * r.inner_radius - settings_.fit_clearance;
+    if (r.inner_radius > 0)
+      return footprint_radius(obj) <= container.bounding_half_extents.x() - settings_.fit_clearance && obj.center_of_mass.z() <= r.inner_depth;
     return 2 * std::max(obj.bounding_half_extents.x(), obj.bounding_half_extents.y()) <= 2 * r.inner_half_extents.minCoeff() - settings_.fit_clearance;
   }
 
@@ -384,10 +401,25 @@ class SceneSampler {
         break;
       }
     }
+    // the relation judged on centres of mass (as the success predicate): it must not hold at the
+    // start (with wider margins) and must hold at the spot (with tighter ones)
+    const auto& pose0 = s.objects[static_cast<std::size_t>(idx[0])].pose;
+    const Eigen::Vector2d com_offset = (pose0.rotation * a.center_of_mass).head<2>();
+    const std::size_t m = 1 + rel.references.size();  // subject, then references
+    std::array<Eigen::Vector2d, 3> centres;
+    for (std::size_t k = 0; k < m; ++k) {
+      const int i = k == 0 ? idx[0] : rel.references[k - 1];
+      const auto& o = s.objects[static_cast<std::size_t>(i)];
+      centres[k] = (o.pose.translation + o.pose.rotation * library_.get(o.asset_id, "ARR object").center_of_mass).head<2>();
+    }
+    const std::span<const Eigen::Vector2d> cs(centres.data(), m);
+    if (geometry::relation_holds(rel.kind, cs, settings_.relations.tightened(-settings_.relation_margin))) return false;
     const Eigen::Vector2d start = pos(idx[0]);
     for (const auto& p : candidates) {
       if (!settings_.band.contains(p, h) || !on_table(s, p, r) || !free(p, r, idx[0])) continue;
       if ((p - start).norm() < settings_.min_goal_distance) continue;
+      centres[0] = p + com_offset;
+      if (!geometry::relation_holds(rel.kind, cs, settings_.relations.tightened(settings_.relation_margin))) continue;
       rel.spots = {Eigen::Vector3d(p.x(), p.y(), s.objects[static_cast<std::size_t>(idx[0])].pose.translation.z())};
       discs_.push_back({p, r});
       s.goal.relations = {rel};
@@ -399,6 +431,7 @@ class SceneSampler {
   SamplerSettings settings_;
   AssetLibrary library_;
   SceneValidator validator_;
+  language::Library language_;
   std::vector<Disc> discs_;
 };
 

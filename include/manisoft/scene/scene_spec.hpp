@@ -16,12 +16,15 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "manisoft/core/error.hpp"
+#include "manisoft/geometry/spatial_relation.hpp"
 #include "manisoft/math/se3.hpp"
 #include "manisoft/render/camera.hpp"
 #include "manisoft/render/scene.hpp"
@@ -45,6 +48,23 @@ inline std::string_view to_string(Task t) {
 }
 inline std::string_view to_string(Setting s) { return s == Setting::clean ? "clean" : "randomized"; }
 inline std::string_view to_string(Split s) { return s == Split::train ? "train" : "eval"; }
+
+namespace detail {
+template <typename E, std::size_t N>
+E parse_name(std::string_view what, std::string_view name, const std::array<E, N>& all) {
+  std::string names;
+  for (E e : all) {
+    if (to_string(e) == name) return e;
+    names += (names.empty() ? "" : ", ") + std::string(to_string(e));
+  }
+  ::manisoft::detail::fail(what, " '", name, "' is not one of ", names);
+}
+}  // namespace detail
+
+/// The enumerator that to_string names ("COLL", "clean", "train"); an error lists the names.
+inline Task parse_task(std::string_view name) { return detail::parse_name("task", name, std::array{Task::coll, Task::aln, Task::stk, Task::arr}); }
+inline Setting parse_setting(std::string_view name) { return detail::parse_name("setting", name, std::array{Setting::clean, Setting::randomized}); }
+inline Split parse_split(std::string_view name) { return detail::parse_name("split", name, std::array{Split::train, Split::eval}); }
 
 /// The table: a box whose top face is centred at top_center, and how its top looks.
 struct TableSpec {
@@ -107,24 +127,12 @@ struct Symmetry {
 /// between: {a}, {b, c}; in_a_row: {a}, {b, c} (a joins b and c in one row). `spots` gives, per
 /// object, a free reachable place on the table where the relation holds (a hint for planners).
 struct Relation {
-  enum class Kind { left_of, right_of, in_front_of, behind, next_to, between, in_a_row } kind = Kind::next_to;
+  using Kind = geometry::RelationKind;
+  Kind kind = Kind::next_to;
   std::vector<int> objects;
   std::vector<int> references;
   std::vector<Eigen::Vector3d> spots;
 };
-
-inline std::string_view to_string(Relation::Kind k) {
-  switch (k) {
-    case Relation::Kind::left_of: return "left_of";
-    case Relation::Kind::right_of: return "right_of";
-    case Relation::Kind::in_front_of: return "in_front_of";
-    case Relation::Kind::behind: return "behind";
-    case Relation::Kind::next_to: return "next_to";
-    case Relation::Kind::between: return "between";
-    case Relation::Kind::in_a_row: return "in_a_row";
-  }
-  return "?";
-}
 
 /// The task's goal; only the part of the scene's task is used (and written to JSON).
 struct Goal {

@@ -13,7 +13,8 @@
 //   ARR   each relation's object at the free spot the scene gives for it (Relation::spots).
 // Orientation: kept as the object stands (translation only) except ALN's yaw.
 // Grasp: among the asset's annotated grasps, each also turned half a turn about the fingers' axis
-// (the parallel gripper is symmetric), the one whose grasp and place end-effector poses turn least
+// (the parallel gripper is symmetric) and turned about the object's axis as its symmetry allows
+// (round: eighth turns, square: quarter turns), the one whose grasp and place end-effector poses turn least
 // from the home pose, whose whole sequence the executor accepts (continuous shapes within the
 // actuation limits, the payload included) and whose waypoint shapes keep every rod node
 // table_clearance above the table top.
@@ -21,7 +22,8 @@
 // ModelExecutor::track_line): approach (the annotation's; "via": first level to above it),
 // grasp, close once settled, carry (above the place pose, diagonal from the grasp; "via": first
 // straight up by lift_height), place (corrected for where the object sits in
-// the hand, measured when it is held), open once settled, then up by retract_height when another
+// the hand, measured when it is held); a line that would cut across the inner edge of the arm's
+// reach (nearer its base than its ends) goes round an arc point about the base instead, open once settled, then up by retract_height when another
 // move follows. A missed grasp re-opens and retries the move from its approach (max_retries).
 // Deterministic; allocation only when a move is planned (path set-ups copy the executor).
 #pragma once
@@ -51,14 +53,17 @@ struct ExpertConfig {
   double lift_height = 0.06;        ///< m: straight up from the grasp first (a "via" carry)
   double place_clearance = 0.008;   ///< m: the object's bottom above its support when released
   double retract_height = 0.06;     ///< m: up after a release that another move follows
-  double path_peak_speed = 0.9;     ///< m/s, peak end-effector speed of a path's quintic timing
-  double max_node_speed = 0.9;      ///< m/s, planned peak speed of any rod node
+  double path_peak_speed = 0.9;     ///< m/s, peak end-effector speed of a path's quintic timing (gripper empty)
+  double max_node_speed = 0.9;      ///< m/s, planned peak speed of any rod node (gripper empty)
+  double carry_peak_speed = 0.9;    ///< m/s, the same while an object is held
+  double carry_node_speed = 0.9;    ///< m/s
   int min_segment_steps = 60;       ///< shortest path, control steps
   double settle_speed = 0.05;       ///< m/s: close / open only when every node is slower
   double settle_error = 0.01;       ///< m: and the end-effector this near its pose
   int max_settle_steps = 200;       ///< longest wait for settling (then act anyway)
   double start_error = 0.015;       ///< m: a chained path starts once the previous one is this near
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
+  double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
   int max_retries = 1;              ///< re-tries of a missed grasp
 };
 
@@ -145,32 +150,55 @@ class Expert {
     Pose object_target;  ///< asset frame -> world at release
     Pose grasp, place;   ///< end-effector poses
     bool via_approach = false, via_carry = false;
-    std::array<Pose, 2> approach_leg, carry_leg;
+    std::array<Pose, 4> approach_leg, carry_leg;
     int approach_count = 1, carry_count = 1;
   };
+
+  /// Appends `to` to a leg, after an arc point when the straight line from `from` would pass
+  /// arc_inset closer to the arm's base (horizontally) than its farther end: the arm reaches an
+  /// annulus about its base, and a chord cuts towards its inner edge. The arc point: the farther end's distance from
+  /// the base at the ends' mean bearing, the higher end's height, the orientations' midway.
+  void append_leg(std::array<Pose, 4>& leg, int& count, const Pose& from, const Pose& to) const {
+    const Eigen::Vector2d base = env_->spec().arm_mount.base_position.head<2>();
+    const Eigen::Vector2d a = from.translation.head<2>() - base, b = to.translation.head<2>() - base, ab = b - a;
+    const double t = ab.squaredNorm() > 1e-12 ? std::clamp(-a.dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+    if ((a + t * ab).norm() < std::max(a.norm(), b.norm()) - config_.arc_inset) {
+      const double r = std::max(a.norm(), b.norm());
+      const double bearing = std::atan2(a.y(), a.x()) + 0.5 * std::remainder(std::atan2(b.y(), b.x()) - std::atan2(a.y(), a.x()), 2 * std::numbers::pi);
+      Pose via;
+      via.translation << base + r * Eigen::Vector2d(std::cos(bearing), std::sin(bearing)), std::max(from.translation.z(), to.translation.z());
+      via.rotation = Eigen::Quaterniond(from.rotation).slerp(0.5, Eigen::Quaterniond(to.rotation)).toRotationMatrix();
+      leg[static_cast<std::size_t>(count++)] = via;
+    }
+    leg[static_cast<std::size_t>(count++)] = to;
+  }
 
   /// The approach leg from the end-effector pose `from` (the annotation's approach pose last).
   void set_approach_leg(Plan& p, const Pose& approach, const Pose& from) const {
     p.approach_count = 0;
+    Pose prev = from;
     if (p.via_approach) {
       Pose above = approach;
       above.translation.z() = std::max(approach.translation.z(), from.translation.z());
-      p.approach_leg[static_cast<std::size_t>(p.approach_count++)] = above;
+      append_leg(p.approach_leg, p.approach_count, prev, above);
+      prev = above;
     }
-    p.approach_leg[static_cast<std::size_t>(p.approach_count++)] = approach;
+    append_leg(p.approach_leg, p.approach_count, prev, approach);
   }
   /// The carry leg from the grasp to carry_height above the place pose.
   void set_carry_leg(Plan& p) const {
     Pose above = p.place;
     above.translation.z() += config_.carry_height;
     p.carry_count = 0;
+    Pose prev = p.grasp;
     if (p.via_carry) {
       Pose lift = p.grasp;
       lift.translation.z() += config_.lift_height;
       above.translation.z() = std::max(above.translation.z(), lift.translation.z());
-      p.carry_leg[static_cast<std::size_t>(p.carry_count++)] = lift;
+      append_leg(p.carry_leg, p.carry_count, prev, lift);
+      prev = lift;
     }
-    p.carry_leg[static_cast<std::size_t>(p.carry_count++)] = above;
+    append_leg(p.carry_leg, p.carry_count, prev, above);
   }
 
   int count_moves() const {
@@ -270,23 +298,31 @@ class Expert {
     };
     std::vector<Candidate> candidates;
     const Pose from = executor_.statics().desired_tip_pose();
+    // the object's symmetry turns a grasp about the object's axis (round: eighth turns, square:
+    // quarter turns); the parallel gripper's turns it half a turn about the fingers' axis
+    const scene::Symmetry sym = scene::asset_symmetry(a);
+    const int object_turns = sym.kind == scene::Symmetry::Kind::axial ? 8 : sym.kind == scene::Symmetry::Kind::discrete ? std::max(1, sym.order) : 1;
     for (const auto& g : a.grasps) {
-      for (int flip = 0; flip < 2; ++flip) {
-        Pose turn;
-        turn.rotation = Eigen::AngleAxisd(flip * std::numbers::pi, Vec3::UnitZ()).toRotationMatrix();
-        for (int variant = 0; variant < 4; ++variant) {
-          Plan p;
-          p.object = object;
-          p.object_target = target;
-          p.grasp = now * g.grasp * turn;
-          p.place = target * now.inverse() * p.grasp;
-          p.via_approach = variant & 1;
-          p.via_carry = variant & 2;
-          set_approach_leg(p, now * g.approach * turn, from);
-          set_carry_leg(p);
-          // least turning first, then the fewest lines
-          const double cost = std::max(turn_from_home(p.grasp), turn_from_home(p.place)) + 1e-3 * variant;
-          candidates.push_back({cost, p});
+      for (int t = 0; t < object_turns; ++t) {
+        Pose about_axis;
+        about_axis.rotation = Eigen::AngleAxisd(2 * std::numbers::pi * t / object_turns, Vec3::UnitZ()).toRotationMatrix();
+        for (int flip = 0; flip < 2; ++flip) {
+          Pose half;
+          half.rotation = Eigen::AngleAxisd(flip * std::numbers::pi, Vec3::UnitZ()).toRotationMatrix();
+          for (int variant = 0; variant < 4; ++variant) {
+            Plan p;
+            p.object = object;
+            p.object_target = target;
+            p.grasp = now * about_axis * g.grasp * half;
+            p.place = target * now.inverse() * p.grasp;
+            p.via_approach = variant & 1;
+            p.via_carry = variant & 2;
+            set_approach_leg(p, now * about_axis * g.approach * half, from);
+            set_carry_leg(p);
+            // least turning first, then the fewest lines
+            const double cost = std::max(turn_from_home(p.grasp), turn_from_home(p.place)) + 1e-3 * variant;
+            candidates.push_back({cost, p});
+          }
         }
       }
     }
@@ -295,8 +331,8 @@ class Expert {
     for (const auto& c : candidates) {
       planner_ = executor_;
       planner_.complete_path();
-      std::array<Pose, 6> seq;
-      std::array<const char*, 6> names{};
+      std::array<Pose, 10> seq;
+      std::array<const char*, 10> names{};
       int n = 0;
       for (int i = 0; i < c.plan.approach_count; ++i) names[n] = "approach", seq[n++] = c.plan.approach_leg[i];
       names[n] = "grasp", seq[n++] = c.plan.grasp;
@@ -359,8 +395,11 @@ class Expert {
   bool start_path(const Pose& goal) {
     const double distance = (goal.translation - executor_.statics().desired_tip_pose().translation).norm();
     const double control_dt = env_->control_dt();
-    const int steps = std::max(config_.min_segment_steps, static_cast<int>(std::ceil(1.875 * distance / config_.path_peak_speed / control_dt)));
-    const auto report = executor_.track_line(goal, steps, config_.max_node_speed * control_dt);
+    const bool loaded = s_ == 1;
+    const double peak = loaded ? config_.carry_peak_speed : config_.path_peak_speed;
+    const double node = loaded ? config_.carry_node_speed : config_.max_node_speed;
+    const int steps = std::max(config_.min_segment_steps, static_cast<int>(std::ceil(1.875 * distance / peak / control_dt)));
+    const auto report = executor_.track_line(goal, steps, node * control_dt);
     if (!report.accepted) {
       give_up(report.reason);
       return false;

@@ -9,8 +9,7 @@
 // checked on hand-built states and on recorded episodes alike. Holding a predicate for a while
 // ("at rest for 1 s") is `SuccessTracker`'s job.
 //
-// Spatial words are the viewer's, looking from the default camera (in front of the table, on +x,
-// towards -x): "left" is world -y, "right" +y, "in front of" +x (towards the camera), "behind" -x.
+// Spatial words are the viewer's (geometry/spatial_relation.hpp): "left" is world -y, "in front of" +x.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,6 +24,7 @@
 
 #include "manisoft/assets/asset.hpp"
 #include "manisoft/core/error.hpp"
+#include "manisoft/geometry/spatial_relation.hpp"
 #include "manisoft/math/se3.hpp"
 
 namespace manisoft::task {
@@ -80,18 +80,8 @@ struct Tolerances {
   double aln_orientation = 0.2;       ///< rad
   // STK: horizontal offset of each item's centre of mass from the one below.
   double stk_horizontal = 0.03;       ///< m
-  // ARR: left_of / right_of / in_front_of / behind put the centres `arr_min_offset` to
-  // `arr_max_offset` apart along the relation's axis and at most `arr_max_cross` apart across it
-  // (RoboTwin's place_a2b: 8-20 cm apart, 5 cm across; widened for 25 cm shoes);
-  double arr_min_offset = 0.05;       ///< m
-  double arr_max_offset = 0.30;       ///< m
-  double arr_max_cross = 0.08;        ///< m
-  // next_to: centres at most this far apart horizontally;
-  double arr_next_to = 0.20;          ///< m
-  // between(a; b, c): a projects onto the middle half of segment b-c, at most this far off it;
-  double arr_between_off_line = 0.05; ///< m
-  // in_a_row: every centre at most this far from the line through the two farthest apart.
-  double arr_row_off_line = 0.03;     ///< m
+  // ARR: the relations' margins (geometry/spatial_relation.hpp).
+  geometry::RelationTolerances arr;
 };
 
 /// True when the object is slower than the rest thresholds and not held.
@@ -201,9 +191,10 @@ inline bool stacked(const Snapshot& snapshot, std::span<const int> items, const 
   return true;
 }
 
-/// ARR: a spatial relation between objects, in the viewer's words (see the header comment).
+/// ARR: a spatial relation between objects, in the viewer's words (geometry/spatial_relation.hpp).
 struct Relation {
-  enum class Kind { left_of, right_of, in_front_of, behind, next_to, between, in_a_row } kind = Kind::next_to;
+  using Kind = geometry::RelationKind;
+  Kind kind = Kind::next_to;
   std::array<int, 4> objects{-1, -1, -1, -1};  ///< left_of..next_to: (a, b) "a <relation> b";
                                                ///< between: (a, b, c) "a between b and c";
                                                ///< in_a_row: 3 or 4 objects, -1 ends the list
@@ -214,71 +205,17 @@ struct Relation {
   }
 };
 
-inline std::string_view to_string(Relation::Kind kind) {
-  switch (kind) {
-    case Relation::Kind::left_of: return "left_of";
-    case Relation::Kind::right_of: return "right_of";
-    case Relation::Kind::in_front_of: return "in_front_of";
-    case Relation::Kind::behind: return "behind";
-    case Relation::Kind::next_to: return "next_to";
-    case Relation::Kind::between: return "between";
-    case Relation::Kind::in_a_row: return "in_a_row";
-  }
-  return "?";
-}
-
 /// Does the relation hold between the objects' centres of mass (horizontal plane)? Positions only.
 inline bool relation_holds(const Snapshot& snapshot, const Relation& relation, const Tolerances& tol = {}) {
-  using Kind = Relation::Kind;
   const int n = relation.count();
-  const int needed = relation.kind == Kind::between ? 3 : relation.kind == Kind::in_a_row ? 3 : 2;
-  if (n < needed || (relation.kind != Kind::in_a_row && n != needed)) {
-    ::manisoft::detail::fail("relation ", to_string(relation.kind), " needs ", needed, relation.kind == Kind::in_a_row ? " or 4" : "",
-         " objects, got ", n);
+  const int lo = geometry::relation_min_count(relation.kind), hi = geometry::relation_max_count(relation.kind);
+  if (n < lo || n > hi) {
+    ::manisoft::detail::fail("relation ", to_string(relation.kind), " needs ", lo, lo == hi ? "" : " or 4", " objects, got ", n);
   }
-  const auto xy = [&](int k) -> Eigen::Vector2d {
-    return detail::object_at(snapshot, relation.objects[static_cast<std::size_t>(k)]).center_of_mass.head<2>();
-  };
-  // Viewer axes in the world's horizontal plane: left = -y, front = +x.
-  const Eigen::Vector2d left(0, -1), front(1, 0);
-  const auto directional = [&](const Eigen::Vector2d& axis) {
-    const Eigen::Vector2d d = xy(0) - xy(1);
-    const double along = d.dot(axis);
-    const double across = std::abs(d.x() * axis.y() - d.y() * axis.x());
-    return along >= tol.arr_min_offset && along <= tol.arr_max_offset && across <= tol.arr_max_cross;
-  };
-  switch (relation.kind) {
-    case Kind::left_of: return directional(left);
-    case Kind::right_of: return directional(-left);
-    case Kind::in_front_of: return directional(front);
-    case Kind::behind: return directional(-front);
-    case Kind::next_to: return (xy(0) - xy(1)).norm() <= tol.arr_next_to;
-    case Kind::between: {
-      const Eigen::Vector2d b = xy(1), c = xy(2), a = xy(0);
-      const Eigen::Vector2d bc = c - b;
-      const double length2 = bc.squaredNorm();
-      if (length2 <= 0) return false;
-      const double t = (a - b).dot(bc) / length2;
-      const double off = std::abs((a - b).x() * bc.y() - (a - b).y() * bc.x()) / std::sqrt(length2);
-      return t >= 0.25 && t <= 0.75 && off <= tol.arr_between_off_line;
-    }
-    case Kind::in_a_row: {
-      // The line through the two centres farthest apart; every centre close to it.
-      int i0 = 0, i1 = 1;
-      double far = -1;
-      for (int i = 0; i < n; ++i)
-        for (int j = i + 1; j < n; ++j)
-          if ((xy(i) - xy(j)).norm() > far) far = (xy(i) - xy(j)).norm(), i0 = i, i1 = j;
-      if (far < tol.arr_min_offset) return false;
-      const Eigen::Vector2d u = (xy(i1) - xy(i0)) / far;
-      for (int k = 0; k < n; ++k) {
-        const Eigen::Vector2d d = xy(k) - xy(i0);
-        if (std::abs(d.x() * u.y() - d.y() * u.x()) > tol.arr_row_off_line) return false;
-      }
-      return true;
-    }
-  }
-  return false;
+  std::array<Eigen::Vector2d, 4> centres;
+  for (int k = 0; k < n; ++k)
+    centres[static_cast<std::size_t>(k)] = detail::object_at(snapshot, relation.objects[static_cast<std::size_t>(k)]).center_of_mass.head<2>();
+  return geometry::relation_holds(relation.kind, std::span<const Eigen::Vector2d>(centres.data(), static_cast<std::size_t>(n)), tol.arr);
 }
 
 /// ARR: every relation holds, every object named in them released and at rest.

@@ -239,7 +239,7 @@ class TaskEnv {
   }
   static Relation to_task_relation(const scene::Relation& r) {
     Relation t;
-    t.kind = static_cast<Relation::Kind>(static_cast<int>(r.kind));  // the same enumerators in the same order
+    t.kind = r.kind;
     std::size_t k = 0;
     for (int i : r.objects) t.objects.at(k++) = i;
     for (int i : r.references) t.objects.at(k++) = i;
