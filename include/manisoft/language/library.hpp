@@ -34,7 +34,7 @@ inline const std::map<std::string, std::set<std::string>>& task_placeholders() {
   return p;
 }
 
-/// ARR relation kinds (task/success.hpp's Relation::Kind names) and their placeholders.
+/// ARR relation kinds (geometry/spatial_relation.hpp's RelationKind names) and their placeholders.
 inline const std::map<std::string, std::set<std::string>>& relation_placeholders() {
   static const std::map<std::string, std::set<std::string>> p{
       {"left_of", {"B"}}, {"right_of", {"B"}}, {"in_front_of", {"B"}}, {"behind", {"B"}},
