@@ -91,8 +91,9 @@ inline math::Pose<double> pose_from(const Trace& t, std::size_t row, const std::
   return pose;
 }
 
-/// The frame of trace row `row` (world_demo's built-in scene, or a spec scene replayed from run_task): rod nodes (frames derived from the centreline:
-/// the trace has no directors), gripper pose and opening, object poses.
+/// The frame of trace row `row` (world_demo's built-in scene, or a spec scene replayed from
+/// run_task): rod nodes (frames derived from the centreline: the trace has no directors), gripper
+/// pose and opening, object poses.
 inline FrameState frame_from_trace(const tabletop::TabletopScene& scene, const Trace& t, std::size_t row) {
   if (row >= t.rows.size()) manisoft::detail::fail("trace: frame ", row, " is out of range: the trace has ", t.rows.size(), " rows (0..", t.rows.size() - 1, ")");
   FrameState f = scene.frame;

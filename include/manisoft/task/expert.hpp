@@ -14,17 +14,18 @@
 // Orientation: kept as the object stands (translation only) except ALN's yaw.
 // Grasp: among the asset's annotated grasps, each also turned half a turn about the fingers' axis
 // (the parallel gripper is symmetric) and turned about the object's axis as its symmetry allows
-// (round: eighth turns, square: quarter turns), the one whose grasp and place end-effector poses turn least
-// from the home pose, whose whole sequence the executor accepts (continuous shapes within the
-// actuation limits, the payload included) and whose waypoint shapes keep every rod node
-// table_clearance above the table top.
+// (round: eighth turns, square: quarter turns), the one whose grasp and place end-effector poses
+// turn least from the home pose, whose whole sequence the executor accepts (continuous shapes
+// within the actuation limits, the payload included) and whose waypoint shapes keep every rod
+// node table_clearance above the table top.
 // Waypoints of a move (the end-effector frame; straight lines with quintic timing,
 // ModelExecutor::track_line): approach (the annotation's; "via": first level to above it),
 // grasp, close once settled, carry (above the place pose, diagonal from the grasp; "via": first
-// straight up by lift_height), place (corrected for where the object sits in
-// the hand, measured when it is held); a line that would cut across the inner edge of the arm's
-// reach (nearer its base than its ends) goes round an arc point about the base instead, open once settled, then up by retract_height when another
-// move follows. A missed grasp re-opens and retries the move from its approach (max_retries).
+// straight up by lift_height), place (corrected for where the object sits in the hand, measured
+// when it is held), open once settled, then up by retract_height when another move follows. A
+// leg whose straight line would pass towards the inner edge of the arm's reach (arc_inset nearer
+// its base than its farther end) goes round an arc point about the base instead. A missed grasp
+// re-opens and retries the move from its approach (max_retries).
 // Deterministic; allocation only when a move is planned (path set-ups copy the executor).
 #pragma once
 
@@ -156,8 +157,9 @@ class Expert {
 
   /// Appends `to` to a leg, after an arc point when the straight line from `from` would pass
   /// arc_inset closer to the arm's base (horizontally) than its farther end: the arm reaches an
-  /// annulus about its base, and a chord cuts towards its inner edge. The arc point: the farther end's distance from
-  /// the base at the ends' mean bearing, the higher end's height, the orientations' midway.
+  /// annulus about its base, and a chord cuts towards its inner edge. The arc point: the farther
+  /// end's distance from the base at the ends' mean bearing, the higher end's height, the
+  /// orientations' midway.
   void append_leg(std::array<Pose, 4>& leg, int& count, const Pose& from, const Pose& to) const {
     const Eigen::Vector2d base = env_->spec().arm_mount.base_position.head<2>();
     const Eigen::Vector2d a = from.translation.head<2>() - base, b = to.translation.head<2>() - base, ab = b - a;
