@@ -14,8 +14,9 @@
 // not the episode's and are reported apart: home_steps()).
 // Task of a seed (draw_task; std::mt19937_64 raw output, own uniform): cube centre uniform in
 // the reachable band x in [0.30, 0.62], y in [-0.25, 0.25], yaw uniform; place point 15-25 cm away
-// in a uniform direction, in the same band; redrawn until the inverse statics holds every
-// waypoint tool-down within the actuation limits with the arm 6 cm clear of the table top.
+// in a uniform direction, in the same band; redrawn until every path, planned from the home shape,
+// needs at most plan_torque_ratio of the actuation limits (headroom for the shape the outer loop
+// and the payload leave at run time) and every waypoint shape is 6 cm clear of the table top.
 // Waypoints (gripper tool-down, yaw = the cube's yaw folded into [-45, 45] deg, constant along the
 // episode): pre-grasp (grasp + pregrasp_height), grasp (grasp centre grasp_height above the table
 // top: fingertips 1 cm above it), carry (above the place point, carry_height higher; a diagonal
@@ -80,6 +81,7 @@ struct PickPlaceConfig {
   int rest_steps = 10;                 ///< control steps at rest after the release
   control::ModelExecutorSettings<double> executor{};
   double table_clearance = 0.06;       ///< m: every node of a waypoint shape this far above the top
+  double plan_torque_ratio = 0.95;     ///< the task draw's paths use at most this fraction of the actuation limits
 };
 
 struct PickPlaceTask {
@@ -182,7 +184,8 @@ class PickPlaceRunner {
       bool ok = true;
       for (std::size_t i = 0; i < w.size() && ok; ++i) {
         if (i == 2) planner_.set_payload(config_.cube_mass, nominal_in_hand);
-        ok = planner_.track_line(w[i], 100).accepted;
+        const auto report = planner_.track_line(w[i], 100);
+        ok = report.accepted && report.max_torque_ratio <= config_.plan_torque_ratio;
         planner_.complete_path();
         ok = ok && planner_.statics().desired_state().positions.col(2).minCoeff() >= top_ + config_.table_clearance;
       }
