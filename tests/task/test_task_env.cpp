@@ -187,7 +187,8 @@ TEST_CASE("the expert solves fixed clean scenes within the horizon", "[tasks][ex
     if (e.info().success) {
       ++solved;
       CHECK(e.info().step <= e.config().horizon);
-      CHECK(expert.phase() == manisoft::task::ExpertPhase::idle);  // it let go before success
+      // it let go before success (and is moving away or holding still)
+      CHECK((expert.phase() == manisoft::task::ExpertPhase::retract || expert.phase() == manisoft::task::ExpertPhase::idle));
     }
   }
   CHECK(solved >= 3);

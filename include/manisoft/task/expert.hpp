@@ -19,10 +19,12 @@
 // within the actuation limits, the payload included) and whose waypoint shapes keep every rod
 // node table_clearance above the table top.
 // Waypoints of a move (the end-effector frame; straight lines with quintic timing,
-// ModelExecutor::track_line): approach (the annotation's; "via": first level to above it),
-// grasp, close once settled, carry (above the place pose, diagonal from the grasp; "via": first
-// straight up by lift_height), place (corrected for where the object sits in the hand, measured
-// when it is held), open once settled, then up by retract_height when another move follows. A
+// ModelExecutor::track_line): approach (along the annotation's approach direction,
+// approach_distance from the grasp; "via": first level to above it), grasp, close once settled
+// (the arm's tip slower than settle_speed), carry (above the place pose, diagonal from the grasp;
+// "via": first straight up by lift_height), place (corrected for where the object sits in the
+// hand, measured when it is held), open once settled or as soon as the support carries the
+// object, then up until the fingertips clear the object's top (after the last move too). A
 // leg whose straight line would pass towards the inner edge of the arm's reach (arc_inset nearer
 // its base than its farther end) goes round an arc point about the base instead. A missed grasp
 // re-opens and retries the move from its approach (max_retries).
@@ -53,19 +55,21 @@ struct ExpertConfig {
   double carry_height = 0.05;       ///< m: end-effector above the place pose before lowering
   double lift_height = 0.06;        ///< m: straight up from the grasp first (a "via" carry)
   double place_clearance = 0.008;   ///< m: the object's bottom above its support when released
-  double retract_height = 0.06;     ///< m: up after a release that another move follows
+  double retract_height = 0.06;     ///< m: up after every release (at least)
+  double finger_clearance = 0.02;   ///< m: and until the fingertips are this far above the released object's top
   double path_peak_speed = 0.9;     ///< m/s, peak end-effector speed of a path's quintic timing (gripper empty)
   double max_node_speed = 0.9;      ///< m/s, planned peak speed of any rod node (gripper empty)
   double carry_peak_speed = 0.9;    ///< m/s, the same while an object is held
   double carry_node_speed = 0.9;    ///< m/s
   int min_segment_steps = 60;       ///< shortest path, control steps
-  double settle_speed = 0.05;       ///< m/s: close / open only when every node is slower
+  double settle_speed = 0.05;       ///< m/s: close / open only when the arm's tip is slower
   double settle_error = 0.01;       ///< m: and the end-effector this near its pose
   int max_settle_steps = 200;       ///< longest wait for settling (then act anyway)
   double start_error = 0.015;       ///< m: a chained path starts once the previous one is this near
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
   int max_retries = 1;              ///< re-tries of a missed grasp
+  double approach_distance = 0.06;  ///< m: the approach pose this far from the grasp, along the annotation's approach direction
 };
 
 /// What the expert is doing.
@@ -173,6 +177,14 @@ class Expert {
       leg[static_cast<std::size_t>(count++)] = via;
     }
     leg[static_cast<std::size_t>(count++)] = to;
+  }
+
+  /// The annotation's approach pose moved to approach_distance from its grasp (same direction).
+  Pose approach_pose(const assets::GraspAnnotation& g) const {
+    Pose a = g.approach;
+    const Vec3 d = g.approach.translation - g.grasp.translation;
+    if (d.norm() > 1e-9) a.translation = g.grasp.translation + config_.approach_distance * d.normalized();
+    return a;
   }
 
   /// The approach leg from the end-effector pose `from` (the annotation's approach pose last).
@@ -319,7 +331,7 @@ class Expert {
             p.place = target * now.inverse() * p.grasp;
             p.via_approach = variant & 1;
             p.via_carry = variant & 2;
-            set_approach_leg(p, now * about_axis * g.approach * half, from);
+            set_approach_leg(p, now * about_axis * approach_pose(g) * half, from);
             set_carry_leg(p);
             // least turning first, then the fewest lines
             const double cost = std::max(turn_from_home(p.grasp), turn_from_home(p.place)) + 1e-3 * variant;
@@ -394,7 +406,8 @@ class Expert {
     enter(ExpertPhase::failed);
   }
 
-  bool start_path(const Pose& goal) {
+  /// Starts the path to `goal`; a refused one ends the episode's plan (give_up) when `required`.
+  bool start_path(const Pose& goal, bool required = true) {
     const double distance = (goal.translation - executor_.statics().desired_tip_pose().translation).norm();
     const double control_dt = env_->control_dt();
     const bool loaded = s_ == 1;
@@ -403,7 +416,7 @@ class Expert {
     const int steps = std::max(config_.min_segment_steps, static_cast<int>(std::ceil(1.875 * distance / peak / control_dt)));
     const auto report = executor_.track_line(goal, steps, node * control_dt);
     if (!report.accepted) {
-      give_up(report.reason);
+      if (required) give_up(report.reason);
       return false;
     }
     target_ = goal;
@@ -414,7 +427,8 @@ class Expert {
   void advance(const TaskEnv::World& w) {
     const auto f = w.soft().end_effector_frame();
     const double error = (f.position - target_.translation).norm();
-    const double speed = w.rod().state().velocities.rowwise().norm().maxCoeff();
+    const auto& v = w.rod().state().velocities;
+    const double speed = v.row(v.rows() - 1).norm();
     const bool done = executor_.path_done();
     const bool settled = done && speed < config_.settle_speed && error < config_.settle_error;
     const auto held = w.gripper().held();
@@ -478,7 +492,10 @@ class Expert {
           give_up("dropped the object");
           break;
         }
-        if (done && (settled || ++waited_ > config_.max_settle_steps)) {
+        // Its support already carries the object (it sank half the clearance below the release
+        // height): open now rather than press it in until it slips.
+        if ((done && (settled || ++waited_ > config_.max_settle_steps)) ||
+            state_of(plan_.object).pose.translation.z() < plan_.object_target.translation.z() - 0.5 * config_.place_clearance) {
           waited_ = 0;
           s_ = 0;
           executor_.set_payload(0.0);
@@ -486,15 +503,23 @@ class Expert {
         }
         break;
       case ExpertPhase::open:
+        // Up and away from the released object, also after the last move (fingers left
+        // around it keep pushing it as the arm sways, and it never comes to rest).
         ++move_;
         retries_ = 0;
-        if (move_ < moves_) {
+        {
+          // retract_height, or more until the fingertips are finger_clearance above the object's top
+          const auto& gp = w.gripper().parameters();
+          const double tips = plan_.place.act(Vec3(0, 0, gp.palm_thickness + gp.finger_length)).z();
+          const double top_of_object = state_of(plan_.object).pose.act(Vec3(0, 0, scene::asset_height(asset_of(plan_.object)))).z();
           Pose up = plan_.place;
-          up.translation.z() += config_.retract_height;
+          up.translation.z() += std::max(config_.retract_height, top_of_object + config_.finger_clearance - tips);
           enter(ExpertPhase::retract);
-          start_path(up);
-        } else {
-          enter(ExpertPhase::idle);
+          // a refused retract is not a failure: the next move plans from here, or the arm holds
+          if (!start_path(up, false)) {
+            if (move_ < moves_) begin_move();
+            else enter(ExpertPhase::idle);
+          }
         }
         break;
       case ExpertPhase::retract:
