@@ -1,8 +1,9 @@
 // Renderer speed (issue 14, section 2): one 514 x 514 frame of the built-in tabletop scene (table,
 // floor, mount, arm tube re-built and re-uploaded every frame, gripper, 8 objects, goal marker),
-// per variant: no shadows, shadows, shadows + depth + id read back, 4x MSAA; and the set-up cost
-// (EGL display + context + shaders + scene upload). Wall time is the reported time (UseRealTime);
-// CPU time shows llvmpipe's worker threads.
+// per variant: no shadows, shadows (1024^2 map, or 512^2), shadows + depth + id read back, 4x MSAA,
+// a spot light (perspective shadow map over its cone); and the set-up cost (EGL display + context +
+// shaders + scene upload). Wall time is the reported time (UseRealTime); CPU time is the calling
+// thread's only (llvmpipe's raster threads are not counted). Every frame is drawn from scratch.
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -18,10 +19,12 @@ void set_shader_cache() {
   if (std::getenv("MESA_SHADER_CACHE_DIR") == nullptr) setenv("MESA_SHADER_CACHE_DIR", "/tmp/manisoft_mesa_shader_cache", 0);
 }
 
-void run_frames(benchmark::State& state, bool shadows, bool readback, int msaa, bool textures = true) {
+void run_frames(benchmark::State& state, bool shadows, bool readback, int msaa, bool textures = true, int shadow_map_size = 1024,
+                bool spot = false) {
   set_shader_cache();
   GlRendererOptions options;
   options.shadows = shadows;
+  options.shadow_map_size = shadow_map_size;
   options.read_depth = readback;
   options.read_mask = readback;
   options.msaa_samples = msaa;
@@ -30,6 +33,7 @@ void run_frames(benchmark::State& state, bool shadows, bool readback, int msaa, 
   if (!textures) {
     for (Material& m : t.scene.materials) m.texture = TextureKind::none;
   }
+  if (spot) t.scene.lighting.kind = LightKind::spot;
   gl.set_scene(t.scene);
   FrameState frame = t.frame;
   frame.goal_pose = tabletop::at(0.3, 0.15, 0.9);
@@ -52,6 +56,8 @@ void BM_Frame_NoShadows(benchmark::State& s) { run_frames(s, false, false, 0); }
 void BM_Frame_NoShadows_NoTextures(benchmark::State& s) { run_frames(s, false, false, 0, false); }
 void BM_Frame_Shadows(benchmark::State& s) { run_frames(s, true, false, 0); }
 void BM_Frame_Shadows_DepthIds(benchmark::State& s) { run_frames(s, true, true, 0); }
+void BM_Frame_Shadows512_DepthIds(benchmark::State& s) { run_frames(s, true, true, 0, true, 512); }
+void BM_Frame_SpotLight_Shadows_DepthIds(benchmark::State& s) { run_frames(s, true, true, 0, true, 1024, true); }
 void BM_Frame_NoShadows_DepthIds(benchmark::State& s) { run_frames(s, false, true, 0); }
 void BM_Frame_MSAA4_Shadows_DepthIds(benchmark::State& s) { run_frames(s, true, true, 4); }
 
@@ -72,6 +78,8 @@ BENCHMARK(BM_Frame_NoShadows)->Unit(benchmark::kMillisecond)->UseRealTime()->Min
 BENCHMARK(BM_Frame_NoShadows_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_Frame_Shadows)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_Frame_Shadows_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_Frame_Shadows512_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_Frame_SpotLight_Shadows_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_Frame_MSAA4_Shadows_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_SetUp)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
 

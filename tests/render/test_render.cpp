@@ -229,6 +229,84 @@ TEST_CASE("the built-in tabletop scene shows the table, arm, gripper and every o
   }
 }
 
+namespace {
+
+// A slab (top at z = 0, no specular) and one 8 cm box on it at the origin; light from -y above.
+SceneDescription shadow_scene(LightKind kind) {
+  SceneDescription s = known_scene();
+  s.materials[0].specular = 0.0f;
+  s.instances.resize(2);
+  s.rod.present = false;
+  s.lighting.kind = kind;
+  s.lighting.direction = {0.0, 1.0, -1.0};  // travels +y and down: the shadow falls on +y
+  s.lighting.position = {0.0, -1.0, 1.0};    // spot: 1.41 m up the light's ray through the origin
+  return s;
+}
+
+int brightness(const RenderOutput& out, const Eigen::Vector3d& p) {
+  const Eigen::Vector2d px = out.camera.project(p);
+  const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+  REQUIRE(u >= 0);
+  REQUIRE(u < out.width);
+  REQUIRE(v >= 0);
+  REQUIRE(v < out.height);
+  const std::size_t i = (static_cast<std::size_t>(v) * out.width + u) * 3;
+  return out.rgb[i] + out.rgb[i + 1] + out.rgb[i + 2];
+}
+
+}  // namespace
+
+TEST_CASE("a caster's shadow falls where the light projects it, for directional and spot lights", "[render]") {
+  FrameState frame;
+  frame.instance_poses = {at(0, 0, -0.02), at(0, 0, 0.04)};
+  // (0, 0.09, 0): its ray to the light passes through the box; (0, -0.09, 0) is lit. Both are on
+  // the slab, seen by the camera, same normal and material.
+  const Eigen::Vector3d shadowed(0, 0.09, 0), lit(0, -0.09, 0);
+  GlRendererOptions plain;
+  plain.shadows = false;
+  GlRenderer no_shadows(plain);
+  for (LightKind kind : {LightKind::directional, LightKind::spot}) {
+    INFO("light kind " << static_cast<int>(kind));
+    const SceneDescription scene = shadow_scene(kind);
+    GlRenderer& gl = renderer();
+    gl.set_scene(scene);
+    const RenderOutput out = gl.render(frame);
+    CHECK(out.id_at(static_cast<int>(std::lround(out.camera.project(shadowed).x())), static_cast<int>(std::lround(out.camera.project(shadowed).y()))) == 1);
+    no_shadows.set_scene(scene);
+    const RenderOutput flat = no_shadows.render(frame);
+    CHECK(brightness(flat, shadowed) - brightness(out, shadowed) > 150);  // sum of R, G, B: the direct light is gone
+    CHECK(std::abs(brightness(flat, lit) - brightness(out, lit)) <= 6);
+  }
+}
+
+TEST_CASE("read-back options and MSAA keep the picture and the ids", "[render]") {
+  const SceneDescription scene = known_scene();
+  const FrameState frame = known_frame();
+  GlRenderer& gl = renderer();
+  gl.set_scene(scene);
+  const RenderOutput full = gl.render(frame);
+  GlRendererOptions colour_only;
+  colour_only.read_depth = false;
+  colour_only.read_mask = false;
+  GlRenderer plain(colour_only);
+  plain.set_scene(scene);
+  const RenderOutput rgb = plain.render(frame);
+  CHECK(rgb.mask.empty());
+  CHECK(rgb.depth.empty());
+  CHECK(rgb.rgb == full.rgb);  // the id target is not drawn, the colours are the same
+  GlRendererOptions msaa;
+  msaa.msaa_samples = 4;
+  GlRenderer smooth(msaa);
+  smooth.set_scene(scene);
+  const RenderOutput out = smooth.render(frame);
+  REQUIRE(out.mask.size() == full.mask.size());
+  std::size_t same = 0;
+  for (std::size_t i = 0; i < out.mask.size(); ++i) same += out.mask[i] == full.mask[i];
+  CHECK(same > out.mask.size() * 97 / 100);  // ids differ only along edges
+  CHECK(out.id_at(0, 0) == 0);
+  CHECK(out.depth_at(0, 0) == 0.0f);
+}
+
 TEST_CASE("mesh builders: tube radius, box extents, directors or transported frames", "[render]") {
   const tabletop::TabletopScene t = tabletop::make_tabletop_scene();
   const RodShape& rod = t.frame.rod;
@@ -255,6 +333,14 @@ TEST_CASE("mesh builders: tube radius, box extents, directors or transported fra
   Eigen::Vector3f hi = Eigen::Vector3f::Constant(-1);
   for (const auto& p : box.positions) hi = hi.cwiseMax(p);
   CHECK(hi.isApprox(Eigen::Vector3f(0.1f, 0.2f, 0.3f)));
+  // make_tube_into replaces a mesh's contents (the renderer reuses one mesh every frame).
+  Mesh reused = make_tube(rod.nodes, rod.directors, rod.radius);
+  const Mesh fresh = make_tube(rod.nodes.topRows(6), rod.directors.topRows(5), 0.5 * rod.radius, TubeOptions{8, 2, true});
+  make_tube_into(reused, rod.nodes.topRows(6), rod.directors.topRows(5), 0.5 * rod.radius, TubeOptions{8, 2, true});
+  CHECK(reused.positions == fresh.positions);
+  CHECK(reused.normals == fresh.normals);
+  CHECK(reused.uvs == fresh.uvs);
+  CHECK(reused.indices == fresh.indices);
   CHECK_THROWS_WITH(make_tube(rod.nodes.topRows(1), rod.directors, 0.05), Contains("need >= 2"));
   CHECK_THROWS_WITH(make_tube(rod.nodes, rod.directors.topRows(3), 0.05), Contains("director rows"));
 }

@@ -1,10 +1,19 @@
 // The in-process OpenGL renderer (ManiSoft paper, section 3.2: the image V_t the
-// policy sees each step): Phong shading with one main light (directional or spot) and ambient
-// light, a shadow map filtered with percentage-closer filtering (4 bilinear comparison taps),
-// procedural solid textures (wood, marble, fabric, checker, noise), optional MSAA, and per-frame
-// read-back of colour, depth (depth buffer, linearised) and object ids (written as a second colour
-// output of the same pass, MRT). Renders into framebuffer objects of an EGL context without a
-// display (egl_context.hpp). Same inputs give the same pixels.
+// policy sees each step): Blinn-Phong shading with one main light (directional or spot) and
+// ambient light, a shadow map filtered with percentage-closer filtering (one bilinear comparison
+// tap: the 2 x 2 texels around the point, weighted), procedural solid textures (wood, marble,
+// fabric, checker, noise), optional MSAA, and per-frame read-back of colour, depth (depth buffer,
+// linearised) and object ids (written as a second colour output of the same pass, MRT). Renders
+// into framebuffer objects of an EGL context without a display (egl_context.hpp). Same inputs give
+// the same pixels.
+//
+// Speed on a CPU (Mesa llvmpipe, BENCHMARKS.md "Renderer"): llvmpipe runs every instruction of a
+// fragment shader on every pixel (both sides of a branch, under a mask), so the shaders are
+// specialised at compile time (texture kind, light kind, shadows) and kept short; a directional
+// light's shadow map is rendered only over the shadow casters' extent (a sub-rectangle of the map
+// at the full map's texel size, so the shadows look the same as with the whole map); the shadow
+// pass culls back faces; the image is rendered upside down so that glReadPixels returns rows top
+// first (no flipping copies); the id target is drawn only when the mask is read.
 #pragma once
 
 #include <GL/glcorearb.h>
@@ -12,6 +21,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -32,7 +42,10 @@ namespace manisoft::render {
 /// Fixed choices of a GlRenderer.
 struct GlRendererOptions {
   bool shadows = true;
-  int shadow_map_size = 1024;  ///< texels a side, in [64, 8192]
+  /// Texels a side of the shadow map, in [64, 8192]. A directional light's map spans the shadow
+  /// sphere (Lighting::shadow_center, shadow_radius); each frame only the part that the shadow
+  /// casters cover (seen from the light) is rendered and cleared.
+  int shadow_map_size = 1024;
   int msaa_samples = 0;        ///< 0 or 1: none; 2, 4, 8: multisampling
   bool read_depth = true;      ///< fill RenderOutput::depth
   bool read_mask = true;       ///< fill RenderOutput::mask
@@ -76,7 +89,6 @@ uniform float u_texture_scale;
 uniform float u_texture_strength;
 uniform float u_specular;
 uniform float u_shininess;
-uniform int u_light_kind;
 uniform vec3 u_light_direction;
 uniform vec3 u_light_position;
 uniform float u_spot_cos;
@@ -84,22 +96,30 @@ uniform vec3 u_light_color;
 uniform vec3 u_ambient;
 uniform vec3 u_camera_position;
 uniform sampler2DShadow u_shadow_map;
-uniform float u_shadow_texel;
+uniform vec2 u_shadow_window;  // texels of the map that the light's projection covers (x, y)
+uniform float u_shadow_size;   // texels a side of the whole map
+uniform float u_shadow_bias;   // depth bias of one texel (normalised light depth)
 uniform uint u_object_id;
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uint o_id;
 
-float hash(vec3 p) {
-  p = fract(p * 0.3183099 + vec3(0.1, 0.2, 0.3));
-  p *= 17.0;
-  return fract(p.x * p.y * p.z * (p.x + p.y + p.z));
-}
+// Value noise: trilinear (smoothstep-weighted) blend of a hash at the 8 corners of the unit cell.
+// The hash of corner c is fract(q.x q.y q.z (q.x + q.y + q.z)) with q = 17 fract(c 0.3183099 +
+// (0.1, 0.2, 0.3)); q's components depend on one axis each, so they are computed once per axis
+// (low corner a, high corner b) and the products shared between corners.
 float value_noise(vec3 x) {
   vec3 i = floor(x);
   vec3 f = fract(x);
   f = f * f * (3.0 - 2.0 * f);
-  return mix(mix(mix(hash(i), hash(i + vec3(1, 0, 0)), f.x), mix(hash(i + vec3(0, 1, 0)), hash(i + vec3(1, 1, 0)), f.x), f.y),
-             mix(mix(hash(i + vec3(0, 0, 1)), hash(i + vec3(1, 0, 1)), f.x), mix(hash(i + vec3(0, 1, 1)), hash(i + vec3(1, 1, 1)), f.x), f.y), f.z);
+  vec3 a = fract(i * 0.3183099 + vec3(0.1, 0.2, 0.3)) * 17.0;
+  vec3 b = fract((i + 1.0) * 0.3183099 + vec3(0.1, 0.2, 0.3)) * 17.0;
+  vec4 xy = vec4(a.x * a.y, b.x * a.y, a.x * b.y, b.x * b.y);  // corners (0,0) (1,0) (0,1) (1,1) in x, y
+  vec4 sxy = vec4(a.x + a.y, b.x + a.y, a.x + b.y, b.x + b.y);
+  vec4 h0 = fract(xy * a.z * (sxy + a.z));  // z = 0
+  vec4 h1 = fract(xy * b.z * (sxy + b.z));  // z = 1
+  vec4 h = mix(h0, h1, f.z);
+  vec2 hy = mix(h.xz, h.yw, f.x);
+  return mix(hy.x, hy.y, f.y);
 }
 float fbm(vec3 p) {
   float sum = 0.0, amplitude = 0.5;
@@ -140,44 +160,57 @@ float pattern(vec3 p) {
 #endif
   return 0.0;
 }
-float shadow_factor(vec3 n, vec3 l) {
+// Fraction of the light reaching the point: one percentage-closer tap over the 2 x 2 texels
+// around it, bilinearly weighted (what a GL_LINEAR comparison sampler returns; textureGather of
+// the four comparisons is cheaper on llvmpipe). p.xy in [0, 1] spans u_shadow_window texels.
+float shadow_factor(float ndl) {
+#if LIGHT_KIND == 0
+  vec3 p = v_light_clip.xyz * 0.5 + 0.5;  // orthographic: w = 1
+#else
   vec3 p = v_light_clip.xyz / v_light_clip.w * 0.5 + 0.5;
+#endif
   if (p.z >= 1.0 || p.x <= 0.0 || p.y <= 0.0 || p.x >= 1.0 || p.y >= 1.0) return 1.0;
-  float bias = u_shadow_texel * (0.5 + 1.5 * (1.0 - max(dot(n, l), 0.0)));
-  float sum = 0.0;
-  sum += texture(u_shadow_map, vec3(p.xy + vec2(-0.75, -0.75) * u_shadow_texel, p.z - bias));
-  sum += texture(u_shadow_map, vec3(p.xy + vec2(0.75, -0.75) * u_shadow_texel, p.z - bias));
-  sum += texture(u_shadow_map, vec3(p.xy + vec2(-0.75, 0.75) * u_shadow_texel, p.z - bias));
-  sum += texture(u_shadow_map, vec3(p.xy + vec2(0.75, 0.75) * u_shadow_texel, p.z - bias));
-  return 0.25 * sum;
+  float z = p.z - u_shadow_bias * (0.5 + 1.5 * (1.0 - ndl));
+  vec2 t = p.xy * u_shadow_window;
+#if GATHER
+  t -= 0.5;
+  vec2 f = fract(t);
+  vec4 g = textureGather(u_shadow_map, (floor(t) + 1.0) / u_shadow_size, z);  // (i,j+1) (i+1,j+1) (i+1,j) (i,j)
+  return mix(mix(g.w, g.z, f.x), mix(g.x, g.y, f.x), f.y);
+#else
+  return texture(u_shadow_map, vec3(t / u_shadow_size, z));
+#endif
+}
+// x^(1/2.2) for x in [0, 1] from square roots (llvmpipe's pow is a long polynomial): a fit in
+// x^(1/4), x^(1/2), x^(3/4), x within 0.11 of an 8-bit level.
+vec3 gamma_encode(vec3 x) {
+  vec3 q = sqrt(sqrt(x));
+  return q * (0.033443686 + q * (1.24112311 - 0.415407581 * q)) + 0.141269234 * x;
 }
 void main() {
-  vec3 n = normalize(v_normal);
-  if (!gl_FrontFacing) n = -n;
+  vec3 n = normalize(v_normal);  // back faces are culled: n faces the camera's side
   vec3 albedo = u_base_color;
 #if TEXTURE_KIND != 0
   albedo = mix(u_base_color, u_secondary_color, clamp(pattern(v_body) * u_texture_strength, 0.0, 1.0));
 #endif
-  vec3 l;
-  float attenuation = 1.0;
-  if (u_light_kind == 0) {
-    l = -u_light_direction;
-  } else {
-    vec3 d = normalize(v_world - u_light_position);
-    l = -d;
-    attenuation = smoothstep(u_spot_cos, u_spot_cos + 0.03, dot(d, u_light_direction));
-  }
+#if LIGHT_KIND == 0
+  vec3 l = -u_light_direction;
+  float lit = 1.0;
+#else
+  vec3 d = normalize(v_world - u_light_position);
+  vec3 l = -d;
+  float lit = smoothstep(u_spot_cos, u_spot_cos + 0.03, dot(d, u_light_direction));
+#endif
   float ndl = max(dot(n, l), 0.0);
-  float lit = attenuation;
 #if SHADOWS
-  if (ndl > 0.0 && lit > 0.0) lit *= shadow_factor(n, l);
+  if (ndl > 0.0 && lit > 0.0) lit *= shadow_factor(ndl);
 #endif
   vec3 v = normalize(u_camera_position - v_world);
   vec3 h = normalize(l + v);
   float specular = ndl > 0.0 ? u_specular * pow(max(dot(n, h), 0.0), u_shininess) : 0.0;
   vec3 ambient = u_ambient * (0.8 + 0.2 * n.z);
   vec3 color = albedo * ambient + (albedo * ndl + vec3(specular)) * u_light_color * lit;
-  o_color = vec4(pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2)), 1.0);
+  o_color = vec4(gamma_encode(clamp(color, 0.0, 1.0)), 1.0);
   o_id = u_object_id;
 }
 )";
@@ -245,8 +278,8 @@ struct GpuMesh {
   std::size_t vertex_capacity = 0, index_capacity = 0;
 };
 
-inline void upload(GpuMesh& g, const Mesh& m, bool dynamic) {
-  std::vector<float> data(m.positions.size() * 6);
+inline void upload(GpuMesh& g, const Mesh& m, bool dynamic, std::vector<float>& data) {
+  data.resize(m.positions.size() * 6);
   for (std::size_t i = 0; i < m.positions.size(); ++i) {
     for (int k = 0; k < 3; ++k) {
       data[6 * i + k] = m.positions[i][k];
@@ -347,13 +380,13 @@ class GlRenderer {
     }
     context_ = std::make_unique<EglContext>(options_.egl);
     try {
-      for (int kind = 0; kind < texture_kinds; ++kind) {
-        const std::string source = "#version 330 core\n#define TEXTURE_KIND " + std::to_string(kind) + "\n#define SHADOWS " +
-                                   (options_.shadows ? "1" : "0") + "\n" + detail_gl::main_fragment_shader;
-        programs_[static_cast<std::size_t>(kind)] = detail_gl::link(detail_gl::main_vertex_shader, source);
-      }
+      GLint major = 0;
+      glGetIntegerv(GL_MAJOR_VERSION, &major);
+      gather_ = major >= 4;  // textureGather on shadow samplers: GLSL 4.00
+      build_programs(0);     // directional light; a spot light's set is built by set_scene
       shadow_program_ = detail_gl::link(detail_gl::shadow_vertex_shader, detail_gl::shadow_fragment_shader);
-      cache_uniforms();
+      u_shadow_model_ = glGetUniformLocation(shadow_program_, "u_model");
+      u_shadow_light_vp_ = glGetUniformLocation(shadow_program_, "u_light_view_projection");
       if (options_.shadows) create_shadow_map();
     } catch (...) {
       release();
@@ -379,12 +412,20 @@ class GlRenderer {
   void set_scene(const SceneDescription& scene) {
     context_->make_current();
     validate_scene(scene);
+    const std::size_t light_set = scene.lighting.kind == LightKind::spot ? 1 : 0;
+    if (programs_[light_set][0] == 0) build_programs(light_set);
+    mesh_bounds_.clear();
+    for (const Mesh& m : scene.meshes) {
+      Eigen::AlignedBox3f box;
+      for (const Eigen::Vector3f& p : m.positions) box.extend(p);
+      mesh_bounds_.push_back(box);
+    }
     for (auto& g : meshes_) detail_gl::destroy(g);
     meshes_.assign(scene.meshes.size(), detail_gl::GpuMesh{});
-    for (std::size_t i = 0; i < scene.meshes.size(); ++i) detail_gl::upload(meshes_[i], scene.meshes[i], false);
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i) detail_gl::upload(meshes_[i], scene.meshes[i], false, upload_scratch_);
     for (auto& g : triad_) detail_gl::destroy(g);
     const std::vector<Mesh> triad = make_axis_triad(scene.goal_marker.axis_length, scene.goal_marker.axis_width);
-    for (std::size_t i = 0; i < 3; ++i) detail_gl::upload(triad_[i], triad[i], false);
+    for (std::size_t i = 0; i < 3; ++i) detail_gl::upload(triad_[i], triad[i], false, upload_scratch_);
     scene_ = scene;
     have_scene_ = true;
   }
@@ -412,6 +453,7 @@ class GlRenderer {
     for (std::size_t i = 0; i < frame.instance_poses.size(); ++i) {
       if (!frame.instance_poses[i].is_finite()) manisoft::detail::fail("GlRenderer::render: pose of instance ", i, " (", scene_.instances[i].name, ") is not finite");
     }
+    if (frame.goal_pose && !frame.goal_pose->is_finite()) manisoft::detail::fail("GlRenderer::render: the goal pose is not finite");
     const Camera& camera = scene_.cameras[camera_index];
     const CameraModel model = camera_model(camera);
     context_->make_current();
@@ -422,21 +464,28 @@ class GlRenderer {
       TubeOptions tube;
       tube.sides = scene_.rod.sides;
       tube.subdivisions = scene_.rod.subdivisions;
-      rod_mesh_ = make_tube(frame.rod.nodes, frame.rod.directors, frame.rod.radius, tube);
-      detail_gl::upload(rod_gpu_, rod_mesh_, true);
+      make_tube_into(rod_mesh_, frame.rod.nodes, frame.rod.directors, frame.rod.radius, tube);
+      detail_gl::upload(rod_gpu_, rod_mesh_, true, upload_scratch_);
     }
 
-    const Eigen::Matrix4f light_vp = light_view_projection();
+    const ShadowProjection shadow = options_.shadows ? shadow_projection(frame, draw_rod) : ShadowProjection{};
     if (options_.shadows) {
+      // Depth of the shadow casters' front faces (back faces culled: the meshes are closed, and
+      // the main pass culls them too), rendered and cleared over the window only.
       glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo_);
-      glViewport(0, 0, options_.shadow_map_size, options_.shadow_map_size);
+      glViewport(0, 0, shadow.window_x, shadow.window_y);
+      glEnable(GL_SCISSOR_TEST);  // one texel beyond the window: a bilinear tap at its edge reads it
+      glScissor(0, 0, std::min(shadow.window_x + 1, options_.shadow_map_size), std::min(shadow.window_y + 1, options_.shadow_map_size));
       glClear(GL_DEPTH_BUFFER_BIT);
+      glDisable(GL_SCISSOR_TEST);
       glEnable(GL_DEPTH_TEST);
-      glDisable(GL_CULL_FACE);
+      glEnable(GL_CULL_FACE);
+      glCullFace(GL_BACK);
+      glFrontFace(GL_CCW);
       glEnable(GL_POLYGON_OFFSET_FILL);
       glPolygonOffset(1.5f, 2.0f);
       glUseProgram(shadow_program_);
-      glUniformMatrix4fv(u_shadow_light_vp_, 1, GL_FALSE, light_vp.data());
+      glUniformMatrix4fv(u_shadow_light_vp_, 1, GL_FALSE, shadow.view_projection.data());
       for (std::size_t i = 0; i < scene_.instances.size(); ++i) {
         if (!scene_.instances[i].casts_shadow) continue;
         const Eigen::Matrix4f m = frame.instance_poses[i].matrix().cast<float>();
@@ -451,29 +500,36 @@ class GlRenderer {
       glDisable(GL_POLYGON_OFFSET_FILL);
     }
 
-    // Main pass: colour to attachment 0, object id to attachment 1.
+    // Main pass: colour to attachment 0, object id to attachment 1 (when the mask is read).
     glBindFramebuffer(GL_FRAMEBUFFER, main_fbo_);
     glViewport(0, 0, camera.width, camera.height);
-    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, options_.read_mask ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
     glDrawBuffers(2, buffers);
     const Eigen::Vector3f bg = scene_.background_color.cwiseMax(0.0f).cwiseMin(1.0f);
     const float clear_color[4] = {std::pow(bg.x(), 1.0f / 2.2f), std::pow(bg.y(), 1.0f / 2.2f), std::pow(bg.z(), 1.0f / 2.2f), 1.0f};
     const GLuint clear_id[4] = {0, 0, 0, 0};
     const GLfloat clear_depth = 1.0f;
     glClearBufferfv(GL_COLOR, 0, clear_color);
-    glClearBufferuiv(GL_COLOR, 1, clear_id);
+    if (options_.read_mask) glClearBufferuiv(GL_COLOR, 1, clear_id);
     glClearBufferfv(GL_DEPTH, 0, &clear_depth);
     glEnable(GL_DEPTH_TEST);
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
-    Eigen::Matrix4d cv_to_gl = Eigen::Matrix4d::Identity();  // OpenCV camera (y down, z forward) -> GL eye (y up, z back)
+    // OpenCV camera (y down, z forward) -> GL eye (y up, z back), then the image turned upside
+    // down (clip y negated) so that GL's bottom-up rows come back top row first: the mirror turns
+    // counter-clockwise front faces clockwise.
+    Eigen::Matrix4d cv_to_gl = Eigen::Matrix4d::Identity();
     cv_to_gl(1, 1) = -1;
     cv_to_gl(2, 2) = -1;
+    Eigen::Matrix4d flip_rows = Eigen::Matrix4d::Identity();
+    flip_rows(1, 1) = -1;
+    glFrontFace(GL_CW);
     Eigen::Matrix4d world_to_camera = Eigen::Matrix4d::Identity();
     world_to_camera.topLeftCorner<3, 3>() = model.R;
     world_to_camera.topRightCorner<3, 1>() = model.t;
     const Eigen::Matrix4f view_projection =
-        (detail_gl::perspective(camera.fov_y_deg * std::numbers::pi / 180.0, static_cast<double>(camera.width) / camera.height, camera.near_clip,
+        (flip_rows *
+         detail_gl::perspective(camera.fov_y_deg * std::numbers::pi / 180.0, static_cast<double>(camera.width) / camera.height, camera.near_clip,
                                 camera.far_clip) *
          cv_to_gl * world_to_camera)
             .cast<float>();
@@ -484,12 +540,13 @@ class GlRenderer {
     const Eigen::Vector3f ambient = light.ambient_color * light.ambient_intensity;
     const Eigen::Vector3f eye = camera.position.cast<float>();
     const float spot_cos = static_cast<float>(std::cos(light.spot_cone_deg * std::numbers::pi / 180.0));
-    for (std::size_t kind = 0; kind < programs_.size(); ++kind) {  // per-frame uniforms of every variant
-      const Uniforms& u = uniforms_[kind];
-      glUseProgram(programs_[kind]);
+    const float shadow_window[2] = {static_cast<float>(shadow.window_x), static_cast<float>(shadow.window_y)};
+    light_set_ = light.kind == LightKind::spot ? 1 : 0;
+    for (std::size_t kind = 0; kind < texture_kinds; ++kind) {  // per-frame uniforms of every variant
+      const Uniforms& u = uniforms_[light_set_][kind];
+      glUseProgram(programs_[light_set_][kind]);
       glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, view_projection.data());
-      glUniformMatrix4fv(u.light_view_projection, 1, GL_FALSE, light_vp.data());
-      glUniform1i(u.light_kind, static_cast<int>(light.kind));
+      glUniformMatrix4fv(u.light_view_projection, 1, GL_FALSE, shadow.view_projection.data());
       glUniform3fv(u.light_direction, 1, light_direction.data());
       glUniform3fv(u.light_position, 1, light_position.data());
       glUniform1f(u.spot_cos, spot_cos);
@@ -497,9 +554,11 @@ class GlRenderer {
       glUniform3fv(u.ambient, 1, ambient.data());
       glUniform3fv(u.camera_position, 1, eye.data());
       glUniform1i(u.shadow_map, 0);
-      glUniform1f(u.shadow_texel, 1.0f / static_cast<float>(options_.shadow_map_size));
+      glUniform2fv(u.shadow_window, 1, shadow_window);
+      glUniform1f(u.shadow_size, static_cast<float>(options_.shadow_map_size));
+      glUniform1f(u.shadow_bias, shadow.bias);
     }
-    current_ = programs_.size() - 1;
+    current_ = texture_kinds - 1;
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, shadow_texture_);
 
@@ -507,7 +566,7 @@ class GlRenderer {
     if (draw_rod) {
       set_material(scene_.materials[static_cast<std::size_t>(scene_.rod.material)]);
       set_model(math::Pose<double>{});
-      glUniform1ui(uniforms_[current_].object_id, scene_.rod.object_id);
+      glUniform1ui(uniforms_[light_set_][current_].object_id, scene_.rod.object_id);
       draw(rod_gpu_);
     }
     for (int pass = 0; pass < 2; ++pass) {
@@ -516,12 +575,11 @@ class GlRenderer {
         if (inst.casts_shadow != (pass == 0)) continue;
         set_material(scene_.materials[static_cast<std::size_t>(inst.material)]);
         set_model(frame.instance_poses[i]);
-        glUniform1ui(uniforms_[current_].object_id, inst.object_id);
+        glUniform1ui(uniforms_[light_set_][current_].object_id, inst.object_id);
         draw(meshes_[static_cast<std::size_t>(inst.mesh)]);
       }
     }
     if (frame.goal_pose) {
-      if (!frame.goal_pose->is_finite()) manisoft::detail::fail("GlRenderer::render: the goal pose is not finite");
       const std::array<Eigen::Vector3f, 3> colors = {Eigen::Vector3f(0.85f, 0.1f, 0.1f), Eigen::Vector3f(0.1f, 0.7f, 0.1f),
                                                      Eigen::Vector3f(0.1f, 0.2f, 0.9f)};
       for (std::size_t a = 0; a < 3; ++a) {
@@ -529,25 +587,26 @@ class GlRenderer {
         m.base_color = colors[a];
         set_material(m);
         set_model(*frame.goal_pose);
-        glUniform1ui(uniforms_[current_].object_id, scene_.goal_marker.object_id);
+        glUniform1ui(uniforms_[light_set_][current_].object_id, scene_.goal_marker.object_id);
         draw(triad_[a]);
       }
     }
 
-    // Resolve MSAA, then read back.
+    // Resolve MSAA, then read back. Rows come back top row first (the image was drawn upside down).
     GLuint read_fbo = main_fbo_;
     if (options_.msaa_samples > 1) {
       glBindFramebuffer(GL_READ_FRAMEBUFFER, main_fbo_);
       glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_);
-      for (int a = 0; a < 2; ++a) {
+      for (int a = 0; a < (options_.read_mask ? 2 : 1); ++a) {
         glReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(a));
         const GLenum draw_buffers[2] = {a == 0 ? GLenum(GL_COLOR_ATTACHMENT0) : GLenum(GL_NONE), a == 1 ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
         glDrawBuffers(2, draw_buffers);
         glBlitFramebuffer(0, 0, camera.width, camera.height, 0, 0, camera.width, camera.height,
-                          GL_COLOR_BUFFER_BIT | (a == 0 ? GL_DEPTH_BUFFER_BIT : 0), GL_NEAREST);
+                          GL_COLOR_BUFFER_BIT | (a == 0 && options_.read_depth ? GL_DEPTH_BUFFER_BIT : 0), GL_NEAREST);
       }
       read_fbo = resolve_fbo_;
     }
+    glFrontFace(GL_CCW);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, read_fbo);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     const int w = camera.width, h = camera.height;
@@ -556,37 +615,30 @@ class GlRenderer {
     out.height = h;
     out.camera = model;
     out.rgb.resize(pixels * 3);
-    scratch_rgb_.resize(pixels * 3);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, scratch_rgb_.data());
-    for (int row = 0; row < h; ++row) {  // GL rows run bottom-up
-      std::copy_n(scratch_rgb_.data() + static_cast<std::size_t>(h - 1 - row) * w * 3, static_cast<std::size_t>(w) * 3,
-                  out.rgb.data() + static_cast<std::size_t>(row) * w * 3);
-    }
+    glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, out.rgb.data());
     if (options_.read_mask) {
-      scratch_mask_.resize(pixels);
       out.mask.resize(pixels);
       glReadBuffer(GL_COLOR_ATTACHMENT1);
-      glReadPixels(0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_SHORT, scratch_mask_.data());
-      for (int row = 0; row < h; ++row) {
-        std::copy_n(scratch_mask_.data() + static_cast<std::size_t>(h - 1 - row) * w, w, out.mask.data() + static_cast<std::size_t>(row) * w);
-      }
+      glReadPixels(0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_SHORT, out.mask.data());
     } else {
       out.mask.clear();
     }
     if (options_.read_depth) {
       scratch_depth_.resize(pixels);
       out.depth.resize(pixels);
-      glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, scratch_depth_.data());
-      const double n = camera.near_clip, f = camera.far_clip;
-      for (int row = 0; row < h; ++row) {
-        const float* src = scratch_depth_.data() + static_cast<std::size_t>(h - 1 - row) * w;
-        float* dst = out.depth.data() + static_cast<std::size_t>(row) * w;
-        for (int col = 0; col < w; ++col) {
-          const double d = src[col];
-          // Window depth d in [0, 1] -> NDC z = 2 d - 1 -> eye distance 2 n f / ((f + n) - z (f - n)).
-          dst[col] = d >= 1.0 ? 0.0f : static_cast<float>(2.0 * n * f / ((f + n) - (2.0 * d - 1.0) * (f - n)));
-        }
+      glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, scratch_depth_.data());
+      // The 24-bit depth D = u >> 8, window depth d = D / M (M = 2^24 - 1) -> NDC z = 2 d - 1 -> eye
+      // distance 2 n f / ((f + n) - z (f - n)) = n f / (n + (1 - d) (f - n)); 1 - d from integers
+      // (no cancellation), in float (vectorised).
+      const float n = static_cast<float>(camera.near_clip), f = static_cast<float>(camera.far_clip);
+      const float nf = n * f, scale = static_cast<float>((camera.far_clip - camera.near_clip) / 16777215.0);
+      const std::uint32_t* src = scratch_depth_.data();
+      float* dst = out.depth.data();
+      for (std::size_t i = 0; i < pixels; ++i) {
+        const auto far_steps = static_cast<std::int32_t>(0xFFFFFFu - (src[i] >> 8));  // M - D
+        const float z = nf / (n + static_cast<float>(far_steps) * scale);
+        dst[i] = far_steps == 0 ? 0.0f : z;
       }
     } else {
       out.depth.clear();
@@ -600,22 +652,26 @@ class GlRenderer {
   struct Uniforms {
     GLint model, normal_matrix, view_projection, light_view_projection;
     GLint base_color, secondary_color, texture_scale, texture_strength, specular, shininess;
-    GLint light_kind, light_direction, light_position, spot_cos, light_color, ambient, camera_position;
-    GLint shadow_map, shadow_texel, object_id;
+    GLint light_direction, light_position, spot_cos, light_color, ambient, camera_position;
+    GLint shadow_map, shadow_window, shadow_size, shadow_bias, object_id;
   };
 
-  void cache_uniforms() {
-    for (std::size_t k = 0; k < programs_.size(); ++k) {
-      const GLuint program = programs_[k];
+  // Compiles the main programs of one light kind (0 directional, 1 spot), one per texture kind.
+  void build_programs(std::size_t light_set) {
+    for (std::size_t kind = 0; kind < texture_kinds; ++kind) {
+      const std::string source = std::string(gather_ ? "#version 400 core\n" : "#version 330 core\n") + "#define TEXTURE_KIND " +
+                                 std::to_string(kind) + "\n#define SHADOWS " + (options_.shadows ? "1" : "0") + "\n#define LIGHT_KIND " +
+                                 std::to_string(light_set) + "\n#define GATHER " + (gather_ ? "1" : "0") + "\n" + detail_gl::main_fragment_shader;
+      const GLuint program = detail_gl::link(detail_gl::main_vertex_shader, source);
+      programs_[light_set][kind] = program;
       auto at = [program](const char* name) { return glGetUniformLocation(program, name); };
-      uniforms_[k] = Uniforms{at("u_model"),          at("u_normal_matrix"),   at("u_view_projection"), at("u_light_view_projection"),
-                              at("u_base_color"),     at("u_secondary_color"), at("u_texture_scale"),   at("u_texture_strength"),
-                              at("u_specular"),       at("u_shininess"),       at("u_light_kind"),      at("u_light_direction"),
-                              at("u_light_position"), at("u_spot_cos"),        at("u_light_color"),     at("u_ambient"),
-                              at("u_camera_position"), at("u_shadow_map"),     at("u_shadow_texel"),    at("u_object_id")};
+      uniforms_[light_set][kind] = Uniforms{at("u_model"),           at("u_normal_matrix"),   at("u_view_projection"),  at("u_light_view_projection"),
+                                            at("u_base_color"),      at("u_secondary_color"), at("u_texture_scale"),    at("u_texture_strength"),
+                                            at("u_specular"),        at("u_shininess"),       at("u_light_direction"),  at("u_light_position"),
+                                            at("u_spot_cos"),        at("u_light_color"),     at("u_ambient"),          at("u_camera_position"),
+                                            at("u_shadow_map"),      at("u_shadow_window"),   at("u_shadow_size"),      at("u_shadow_bias"),
+                                            at("u_object_id")};
     }
-    u_shadow_model_ = glGetUniformLocation(shadow_program_, "u_model");
-    u_shadow_light_vp_ = glGetUniformLocation(shadow_program_, "u_light_view_projection");
   }
 
   void validate_scene(const SceneDescription& scene) const {
@@ -656,26 +712,78 @@ class GlRenderer {
     manisoft::detail::require_non_negative("Lighting ambient_intensity", l.ambient_intensity);
   }
 
-  Eigen::Matrix4f light_view_projection() const {
+  /// The light's view-projection and the part of the shadow map it covers.
+  struct ShadowProjection {
+    Eigen::Matrix4f view_projection = Eigen::Matrix4f::Identity();
+    int window_x = 1, window_y = 1;  ///< texels
+    float bias = 0;                  ///< normalised light depth of one texel
+  };
+
+  // A spot light: a perspective frustum over its cone, the whole map. A directional light: an
+  // orthographic projection whose texels are those of the whole map spanning the shadow sphere
+  // (side 2 r), restricted to the texels that the shadow casters cover as seen from the light
+  // (plus one texel a side): the shadow map's contents there are those of the whole map, at a
+  // fraction of the fill and clear cost.
+  ShadowProjection shadow_projection(const FrameState& frame, bool draw_rod) const {
     const Lighting& l = scene_.lighting;
     const Eigen::Vector3d dir = l.direction.normalized();
-    if (l.kind == LightKind::directional) {
-      const double r = l.shadow_radius;
-      const Eigen::Vector3d eye = l.shadow_center - dir * (2.0 * r);
-      return (detail_gl::orthographic(r, 0.5 * r, 3.5 * r).cast<float>() * detail_gl::look_at(eye, l.shadow_center, Eigen::Vector3d::UnitZ()));
+    const int size = options_.shadow_map_size;
+    ShadowProjection out;
+    out.bias = 1.0f / static_cast<float>(size);
+    if (l.kind != LightKind::directional) {
+      out.view_projection = detail_gl::perspective(2.0 * l.spot_cone_deg * std::numbers::pi / 180.0, 1.0, 0.1, 20.0).cast<float>() *
+                            detail_gl::look_at(l.position, l.position + dir, Eigen::Vector3d::UnitZ());
+      out.window_x = out.window_y = size;
+      return out;
     }
-    return (detail_gl::perspective(2.0 * l.spot_cone_deg * std::numbers::pi / 180.0, 1.0, 0.1, 20.0).cast<float>() *
-            detail_gl::look_at(l.position, l.position + dir, Eigen::Vector3d::UnitZ()));
+    const double r = l.shadow_radius;
+    const Eigen::Vector3d eye = l.shadow_center - dir * (2.0 * r);
+    const Eigen::Matrix4f view = detail_gl::look_at(eye, l.shadow_center, Eigen::Vector3d::UnitZ());
+    // The casters' extent in the light's view (x, y).
+    Eigen::AlignedBox2f extent;
+    for (std::size_t i = 0; i < scene_.instances.size(); ++i) {
+      const Instance& inst = scene_.instances[i];
+      if (!inst.casts_shadow) continue;
+      const Eigen::AlignedBox3f& box = mesh_bounds_[static_cast<std::size_t>(inst.mesh)];
+      if (box.isEmpty()) continue;
+      const Eigen::Matrix4f to_light = view * frame.instance_poses[i].matrix().cast<float>();
+      for (int c = 0; c < 8; ++c) {
+        const Eigen::Vector3f corner = box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c));
+        extent.extend((to_light.topLeftCorner<2, 3>() * corner + to_light.topRightCorner<2, 1>()).eval());
+      }
+    }
+    if (draw_rod) {
+      for (const Eigen::Vector3f& p : rod_mesh_.positions) extent.extend((view.topLeftCorner<2, 3>() * p + view.topRightCorner<2, 1>()).eval());
+    }
+    // Whole-map texel k spans [-r + k tau, -r + (k + 1) tau]; the window is texels [k0, k1).
+    const double tau = 2.0 * r / size;
+    std::array<int, 2> k0{0, 0}, k1{1, 1};
+    if (!extent.isEmpty()) {
+      for (int a = 0; a < 2; ++a) {
+        k0[a] = std::clamp(static_cast<int>(std::floor((extent.min()[a] + r) / tau)) - 1, 0, size - 1);
+        k1[a] = std::clamp(static_cast<int>(std::ceil((extent.max()[a] + r) / tau)) + 1, k0[a] + 1, size);
+      }
+    }
+    Eigen::Matrix4d projection = detail_gl::orthographic(r, 0.5 * r, 3.5 * r);
+    for (int a = 0; a < 2; ++a) {
+      const double lo = -r + k0[a] * tau, hi = -r + k1[a] * tau;
+      projection(a, a) = 2.0 / (hi - lo);
+      projection(a, 3) = -(hi + lo) / (hi - lo);
+    }
+    out.view_projection = projection.cast<float>() * view;
+    out.window_x = k1[0] - k0[0];
+    out.window_y = k1[1] - k0[1];
+    return out;
   }
 
   // Selects the program of the material's texture kind and sets the material's uniforms.
   void set_material(const Material& m) {
     const auto kind = static_cast<std::size_t>(m.texture);
     if (kind != current_) {
-      glUseProgram(programs_[kind]);
+      glUseProgram(programs_[light_set_][kind]);
       current_ = kind;
     }
-    const Uniforms& u = uniforms_[current_];
+    const Uniforms& u = uniforms_[light_set_][current_];
     glUniform3fv(u.base_color, 1, m.base_color.data());
     glUniform3fv(u.secondary_color, 1, m.secondary_color.data());
     glUniform1f(u.texture_scale, m.texture_scale);
@@ -687,8 +795,8 @@ class GlRenderer {
   void set_model(const math::Pose<double>& pose) {
     const Eigen::Matrix4f m = pose.matrix().cast<float>();
     const Eigen::Matrix3f n = pose.rotation.cast<float>();  // orthonormal: the normal matrix is the rotation
-    glUniformMatrix4fv(uniforms_[current_].model, 1, GL_FALSE, m.data());
-    glUniformMatrix3fv(uniforms_[current_].normal_matrix, 1, GL_FALSE, n.data());
+    glUniformMatrix4fv(uniforms_[light_set_][current_].model, 1, GL_FALSE, m.data());
+    glUniformMatrix3fv(uniforms_[light_set_][current_].normal_matrix, 1, GL_FALSE, n.data());
   }
 
   static void draw(const detail_gl::GpuMesh& g) {
@@ -766,9 +874,11 @@ class GlRenderer {
     destroy_targets();
     if (shadow_fbo_) glDeleteFramebuffers(1, &shadow_fbo_);
     if (shadow_texture_) glDeleteTextures(1, &shadow_texture_);
-    for (GLuint& p : programs_) {
-      if (p) glDeleteProgram(p);
-      p = 0;
+    for (auto& set : programs_) {
+      for (GLuint& p : set) {
+        if (p) glDeleteProgram(p);
+        p = 0;
+      }
     }
     if (shadow_program_) glDeleteProgram(shadow_program_);
     shadow_fbo_ = shadow_texture_ = shadow_program_ = 0;
@@ -779,13 +889,16 @@ class GlRenderer {
   std::unique_ptr<EglContext> context_;
   SceneDescription scene_;
   bool have_scene_ = false;
-  static constexpr int texture_kinds = 6;  // TextureKind none..noise
-  std::array<GLuint, texture_kinds> programs_{};
-  std::array<Uniforms, texture_kinds> uniforms_{};
-  std::size_t current_ = 0;  // program in use (texture kind)
+  static constexpr std::size_t texture_kinds = 6;  // TextureKind none..noise
+  bool gather_ = false;                            // GLSL 4.00: textureGather for the shadow tap
+  std::array<std::array<GLuint, texture_kinds>, 2> programs_{};  // [light kind][texture kind]
+  std::array<std::array<Uniforms, texture_kinds>, 2> uniforms_{};
+  std::size_t light_set_ = 0;  // light kind of the frame being drawn
+  std::size_t current_ = 0;    // program in use (texture kind)
   GLuint shadow_program_ = 0;
   GLint u_shadow_model_ = -1, u_shadow_light_vp_ = -1;
   std::vector<detail_gl::GpuMesh> meshes_;
+  std::vector<Eigen::AlignedBox3f> mesh_bounds_;  // body frame
   std::array<detail_gl::GpuMesh, 3> triad_{};
   detail_gl::GpuMesh rod_gpu_;
   Mesh rod_mesh_;
@@ -793,9 +906,8 @@ class GlRenderer {
   GLuint main_fbo_ = 0, resolve_fbo_ = 0;
   std::array<GLuint, 3> main_rbs_{0, 0, 0}, resolve_rbs_{0, 0, 0};
   int target_width_ = 0, target_height_ = 0;
-  std::vector<std::uint8_t> scratch_rgb_;
-  std::vector<std::uint16_t> scratch_mask_;
-  std::vector<float> scratch_depth_;
+  std::vector<std::uint32_t> scratch_depth_;
+  std::vector<float> upload_scratch_;
 };
 
 }  // namespace manisoft::render

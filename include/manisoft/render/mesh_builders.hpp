@@ -265,9 +265,11 @@ struct TubeOptions {
 /// curve through the (n + 1) nodes; ring frames from the directors when given (d1 averaged at the
 /// nodes, interpolated and made orthogonal to the curve's tangent), else transported along the
 /// curve. Throws for fewer than 2 nodes, non-finite input, or mismatched director rows.
-inline Mesh make_tube(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& nodes,
-                      const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor>>& directors, double radius,
-                      const TubeOptions& options = {}) {
+/// make_tube_into writes into `m` (replacing its contents, reusing its storage: the renderer
+/// rebuilds the tube every frame).
+inline void make_tube_into(Mesh& m, const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& nodes,
+                           const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor>>& directors, double radius,
+                           const TubeOptions& options = {}) {
   manisoft::detail::require_positive("make_tube: radius", radius);
   detail_mesh::require_segments("make_tube: sides", options.sides, 3);
   detail_mesh::require_segments("make_tube: subdivisions", options.subdivisions, 1);
@@ -317,10 +319,19 @@ inline Mesh make_tube(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynami
     }
   }
   const std::vector<Eigen::Vector3d> transported = transport_normals(tangents, have_directors ? normals[0] : Eigen::Vector3d::UnitZ());
-  Mesh m;
+  m.positions.clear();
+  m.normals.clear();
+  m.uvs.clear();
+  m.indices.clear();
   const int sides = options.sides;
   const double pi = std::numbers::pi;
   const auto row = static_cast<std::uint32_t>(sides + 1);
+  std::vector<double> cosines(static_cast<std::size_t>(sides) + 1), sines(static_cast<std::size_t>(sides) + 1);
+  for (int j = 0; j <= sides; ++j) {
+    const double phi = 2 * pi * j / sides;
+    cosines[static_cast<std::size_t>(j)] = std::cos(phi);
+    sines[static_cast<std::size_t>(j)] = std::sin(phi);
+  }
   std::vector<Eigen::Vector3d> n1s(centres.size()), n2s(centres.size());
   for (std::size_t i = 0; i < centres.size(); ++i) {
     const Eigen::Vector3d& t = tangents[i];
@@ -332,8 +343,7 @@ inline Mesh make_tube(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynami
     n1s[i] = n1;
     n2s[i] = t.cross(n1);
     for (int j = 0; j <= sides; ++j) {
-      const double phi = 2 * pi * j / sides;
-      const Eigen::Vector3d radial = std::cos(phi) * n1 + std::sin(phi) * n2s[i];
+      const Eigen::Vector3d radial = cosines[static_cast<std::size_t>(j)] * n1 + sines[static_cast<std::size_t>(j)] * n2s[i];
       detail_mesh::add_vertex(m, (centres[i] + radius * radial).cast<float>(), radial.cast<float>(),
                               {static_cast<float>(i) / (centres.size() - 1), static_cast<float>(j) / sides});
     }
@@ -352,10 +362,9 @@ inline Mesh make_tube(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynami
       const std::uint32_t centre = detail_mesh::add_vertex(m, centres[i].cast<float>(), n, {0.5f, 0.5f});
       const auto first = static_cast<std::uint32_t>(m.positions.size());
       for (int j = 0; j <= sides; ++j) {
-        const double phi = 2 * pi * j / sides;
-        const Eigen::Vector3d radial = std::cos(phi) * n1s[i] + std::sin(phi) * n2s[i];
-        detail_mesh::add_vertex(m, (centres[i] + radius * radial).cast<float>(), n,
-                                {static_cast<float>(0.5 + 0.5 * std::cos(phi)), static_cast<float>(0.5 + 0.5 * std::sin(phi))});
+        const double c = cosines[static_cast<std::size_t>(j)], sn = sines[static_cast<std::size_t>(j)];
+        const Eigen::Vector3d radial = c * n1s[i] + sn * n2s[i];
+        detail_mesh::add_vertex(m, (centres[i] + radius * radial).cast<float>(), n, {static_cast<float>(0.5 + 0.5 * c), static_cast<float>(0.5 + 0.5 * sn)});
       }
       for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(sides); ++j) {
         if (end == 0) detail_mesh::add_triangle(m, centre, first + j + 1, first + j);
@@ -363,6 +372,13 @@ inline Mesh make_tube(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynami
       }
     }
   }
+}
+
+inline Mesh make_tube(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>& nodes,
+                      const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor>>& directors, double radius,
+                      const TubeOptions& options = {}) {
+  Mesh m;
+  make_tube_into(m, nodes, directors, radius, options);
   return m;
 }
 
