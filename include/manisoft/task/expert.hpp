@@ -423,6 +423,11 @@ class Expert {
     return true;
   }
 
+  /// Whether something under the held object carries it (see the lower phase).
+  bool supported(const ObjectState& o) const {
+    return o.touching != 0 || o.touches_table || o.pose.translation.z() < plan_.object_target.translation.z() - 0.5 * config_.place_clearance;
+  }
+
   /// The phase machine, after the last control step.
   void advance(const TaskEnv::World& w) {
     const auto f = w.soft().end_effector_frame();
@@ -492,10 +497,10 @@ class Expert {
           give_up("dropped the object");
           break;
         }
-        // Its support already carries the object (it sank half the clearance below the release
-        // height): open now rather than press it in until it slips.
-        if ((done && (settled || ++waited_ > config_.max_settle_steps)) ||
-            state_of(plan_.object).pose.translation.z() < plan_.object_target.translation.z() - 0.5 * config_.place_clearance) {
+        // Its support already carries the object (it touches the table or another object, or
+        // sank half the clearance below the release height): open now rather than press it in
+        // until it slips.
+        if ((done && (settled || ++waited_ > config_.max_settle_steps)) || supported(state_of(plan_.object))) {
           waited_ = 0;
           s_ = 0;
           executor_.set_payload(0.0);
