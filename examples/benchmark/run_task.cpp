@@ -44,11 +44,11 @@ int main(int argc, char** argv) {
   app.add_option("--path-speed", expert_config.path_peak_speed, "expert: peak end-effector speed of a path with the gripper empty, m/s")->check(CLI::PositiveNumber);
   app.add_option("--node-speed", expert_config.max_node_speed, "expert: planned peak speed of any rod node with the gripper empty, m/s")->check(CLI::PositiveNumber);
   app.add_option("--carry-speed", expert_config.carry_peak_speed, "expert: peak end-effector speed while holding, m/s")->check(CLI::PositiveNumber);
+  app.add_option("--carry-node-speed", expert_config.carry_node_speed, "expert: planned peak node speed while holding, m/s")->check(CLI::PositiveNumber);
   app.add_option("--settle-speed", expert_config.settle_speed, "expert: close / open once the arm's tip is slower, m/s")->check(CLI::PositiveNumber);
   app.add_option("--start-error", expert_config.start_error, "expert: a chained path starts once the previous one is this near its end, m")->check(CLI::PositiveNumber);
   app.add_option("--place-clearance", expert_config.place_clearance, "expert: the object's bottom above its support when released, m")->check(CLI::NonNegativeNumber);
   app.add_option("--approach-distance", expert_config.approach_distance, "expert: approach pose distance from the grasp, m")->check(CLI::PositiveNumber);
-  app.add_option("--carry-node-speed", expert_config.carry_node_speed, "expert: planned peak node speed while holding, m/s")->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   try {
     const std::clock_t c0 = std::clock();

@@ -428,6 +428,17 @@ class Expert {
     return o.touching != 0 || o.touches_table || o.pose.translation.z() < plan_.object_target.translation.z() - 0.5 * config_.place_clearance;
   }
 
+  /// Above the place pose by retract_height, or more until the fingertips are finger_clearance
+  /// above the released object's top.
+  Pose retract_pose() const {
+    const auto& gp = env_->gripper_parameters();
+    const double tips = plan_.place.act(Vec3(0, 0, gp.palm_thickness + gp.finger_length)).z();
+    const double top_of_object = state_of(plan_.object).pose.act(Vec3(0, 0, scene::asset_height(asset_of(plan_.object)))).z();
+    Pose up = plan_.place;
+    up.translation.z() += std::max(config_.retract_height, top_of_object + config_.finger_clearance - tips);
+    return up;
+  }
+
   /// The phase machine, after the last control step.
   void advance(const TaskEnv::World& w) {
     const auto f = w.soft().end_effector_frame();
@@ -512,19 +523,11 @@ class Expert {
         // around it keep pushing it as the arm sways, and it never comes to rest).
         ++move_;
         retries_ = 0;
-        {
-          // retract_height, or more until the fingertips are finger_clearance above the object's top
-          const auto& gp = w.gripper().parameters();
-          const double tips = plan_.place.act(Vec3(0, 0, gp.palm_thickness + gp.finger_length)).z();
-          const double top_of_object = state_of(plan_.object).pose.act(Vec3(0, 0, scene::asset_height(asset_of(plan_.object)))).z();
-          Pose up = plan_.place;
-          up.translation.z() += std::max(config_.retract_height, top_of_object + config_.finger_clearance - tips);
-          enter(ExpertPhase::retract);
-          // a refused retract is not a failure: the next move plans from here, or the arm holds
-          if (!start_path(up, false)) {
-            if (move_ < moves_) begin_move();
-            else enter(ExpertPhase::idle);
-          }
+        enter(ExpertPhase::retract);
+        // a refused retract is not a failure: the next move plans from here, or the arm holds
+        if (!start_path(retract_pose(), false)) {
+          if (move_ < moves_) begin_move();
+          else enter(ExpertPhase::idle);
         }
         break;
       case ExpertPhase::retract:
