@@ -1,17 +1,20 @@
 // The `manisoft` Python module (pybind11): the soft-arm environments with Gymnasium's API,
-// without depending on gymnasium. Today: the reach environment (env/reach_env.hpp, the paper's
-// executor benchmark, section 3.4) and its model-based expert; the benchmark's task environments
-// join it as they land.
+// without depending on gymnasium: the four benchmark tasks (task_environment.hpp: COLL, ALN, STK,
+// ARR with the camera image, the instruction and the expert) and the reach environment
+// (env/reach_env.hpp, the paper's executor benchmark, section 3.4) with its model-based expert;
+// scene sampling and rendering a given state.
 //
 //   import manisoft
-//   env = manisoft.make_env("reach", target_set="table", seed=0)
-//   obs, info = env.reset(seed=3)
+//   env = manisoft.make_env("COLL", "clean", seed=0, render=True)
+//   obs, info = env.reset(options={"index": 3})          # obs["image"], obs["instruction"]
 //   obs, reward, terminated, truncated, info = env.step(env.expert_action())
+//   reach = manisoft.make_env("reach", target_set="table", seed=0)
 //
-// Actions: float64 (n x 3) material-frame element torques (other real dtypes are converted);
-// clamped to the actuation limits (action_space["low"/"high"]). Bad input (shape, dtype, NaN, a
-// call after close) raises ValueError / RuntimeError with the library's message; the GIL is
-// released while the simulation steps.
+// Task actions: float vectors of 3n + 1 (torques row by row, then S); reach actions: (n x 3)
+// torques. Other real dtypes are converted; torques are clamped to the actuation limits
+// (action_space["low"/"high"]). Bad input (shape, dtype, NaN, a call after close) raises
+// ValueError / RuntimeError with the library's message; the GIL is released while the simulation
+// steps and while a frame renders.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -23,6 +26,7 @@
 
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/env/reach_env.hpp"
+#include "task_environment.hpp"
 
 namespace py = pybind11;
 
@@ -181,6 +185,39 @@ class ReachEnvironment {
   bool closed_ = false;
 };
 
+/// Renders any state of a scene: for replaying recorded states or a user's own.
+class StateRenderer {
+ public:
+  py::array_t<std::uint8_t> render(const std::string& scene_json, const py::array& rod_nodes, const py::handle& gripper_pose, double finger_width,
+                                   const py::array& object_poses, const std::optional<py::dict>& camera) {
+    const auto spec = manisoft::scene::parse_scene(scene_json, "Renderer.render(scene)");
+    manisoft::scene::require_consistent(spec, sampler_.library(), "Renderer.render(scene)");
+    const auto nodes = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(rod_nodes);
+    if (!nodes || nodes.ndim() != 2 || nodes.shape(1) != 3 || nodes.shape(0) < 2) throw py::value_error("rod_nodes must be an (n+1) x 3 array, n >= 1");
+    Eigen::Matrix<double, Eigen::Dynamic, 3> x(nodes.shape(0), 3);
+    const auto nv = nodes.unchecked<2>();
+    for (py::ssize_t i = 0; i < nodes.shape(0); ++i)
+      for (int c = 0; c < 3; ++c) x(i, c) = nv(i, c);
+    if (!x.allFinite()) throw py::value_error("rod_nodes is not finite");
+    if (!std::isfinite(finger_width) || finger_width < 0) throw py::value_error("finger_width must be finite and >= 0");
+    const auto poses = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object_poses);
+    if (!poses || poses.ndim() != 3 || poses.shape(1) != 4 || poses.shape(2) != 4 || poses.shape(0) != static_cast<py::ssize_t>(spec.objects.size()))
+      throw py::value_error("object_poses must be an array of " + std::to_string(spec.objects.size()) + " 4 x 4 matrices (one per scene object)");
+    std::vector<manisoft::math::Pose<double>> objects;
+    for (py::ssize_t i = 0; i < poses.shape(0); ++i) objects.push_back(manisoft_py::pose_of(poses[py::make_tuple(i)], "object_poses[" + std::to_string(i) + "]"));
+    const auto gripper = manisoft_py::pose_of(gripper_pose, "gripper_pose");
+    if (!gl_) gl_ = manisoft_py::make_policy_renderer();
+    manisoft_py::SceneRenderer r(spec, sampler_.library(),
+                                 camera ? manisoft_py::camera_of(*camera, spec.cameras.front()) : spec.cameras.front(), *gl_);
+    r.set_state(x, gripper, finger_width, objects);
+    return r.render();
+  }
+
+ private:
+  manisoft::scene::SceneSampler sampler_;
+  std::unique_ptr<manisoft::render::GlRenderer> gl_;
+};
+
 }  // namespace
 
 PYBIND11_MODULE(manisoft, m) {
@@ -204,12 +241,58 @@ PYBIND11_MODULE(manisoft, m) {
       .def_property_readonly("action_space", &ReachEnvironment::action_space)
       .def_property_readonly("observation_space", &ReachEnvironment::observation_space)
       .def_property_readonly("horizon", &ReachEnvironment::horizon);
+  using manisoft_py::TaskEnvironment;
+  py::class_<TaskEnvironment>(m, "TaskEnv",
+                              "A ManiSoft task (COLL, ALN, STK, ARR): instruction and camera image in, torques and gripper state out (paper section 3.2)")
+      .def("reset", &TaskEnvironment::reset, py::arg("seed") = py::none(), py::arg("options") = py::none(),
+           "Starts an episode on scene (task, setting, split, options['index'], seed): (observation, info). Options: index, split, "
+           "instruction ('canonical'|'seen'|'unseen'), instruction_index, scene (JSON text)")
+      .def("step", &TaskEnvironment::step, py::arg("action"),
+           "One control step (7 x 0.2 ms): (observation, reward, terminated, truncated, info)")
+      .def("expert_action", &TaskEnvironment::expert_action, "The rule-based expert's action now (privileged: it reads the world)")
+      .def("render", &TaskEnvironment::render, "The current camera image (uint8 H x W x 3)")
+      .def("close", &TaskEnvironment::close)
+      .def("scene_json", &TaskEnvironment::scene_json, "The episode's scene (manisoft.scene/1 JSON)")
+      .def_property_readonly("expert_phase", &TaskEnvironment::expert_phase)
+      .def_property_readonly("action_space", &TaskEnvironment::action_space)
+      .def_property_readonly("observation_space", &TaskEnvironment::observation_space)
+      .def_property_readonly("horizon", &TaskEnvironment::horizon)
+      .def_property_readonly("n_elements", &TaskEnvironment::n_elements);
   m.def(
       "make_env",
-      [](const std::string& name, const std::string& target_set, std::uint64_t seed, int horizon) {
-        if (name != "reach") throw py::value_error("make_env: unknown environment '" + name + "' (available: reach)");
-        return std::make_unique<ReachEnvironment>(target_set, seed, horizon);
+      [](const std::string& name, const std::string& setting, std::uint64_t seed, bool render, const std::optional<py::dict>& camera,
+         bool privileged, const std::string& split, const std::string& target_set, int horizon) -> py::object {
+        if (name == "reach") return py::cast(std::make_unique<ReachEnvironment>(target_set, seed, horizon));
+        if (name != "COLL" && name != "ALN" && name != "STK" && name != "ARR")
+          throw py::value_error("make_env: unknown environment '" + name + "' (available: COLL, ALN, STK, ARR, reach)");
+        if (horizon != 1500) throw py::value_error("make_env: the tasks' horizon is the paper's T = 1500");
+        return py::cast(std::make_unique<TaskEnvironment>(name, setting, seed, render, camera, privileged, split));
       },
-      py::arg("name"), py::arg("target_set") = "table", py::arg("seed") = 0, py::arg("horizon") = 1500,
-      "Makes an environment: make_env('reach', target_set='table'|'equilibria', seed=0, horizon=1500)");
+      py::arg("name"), py::arg("setting") = "clean", py::arg("seed") = 0, py::arg("render") = false, py::arg("camera") = py::none(),
+      py::arg("privileged") = false, py::arg("split") = "train", py::arg("target_set") = "table", py::arg("horizon") = 1500,
+      "Makes an environment: make_env('COLL'|'ALN'|'STK'|'ARR', 'clean'|'randomized', seed=0, render=False, camera=None, "
+      "privileged=False, split='train'), or make_env('reach', target_set='table'|'equilibria', seed=0, horizon=1500)");
+  py::class_<manisoft::scene::SceneSampler>(m, "SceneSampler", "The benchmark's scenes (assets, layouts, instructions), drawn deterministically")
+      .def(py::init<>())
+      .def(
+          "sample",
+          [](manisoft::scene::SceneSampler& sampler, const std::string& task, const std::string& setting, std::uint64_t index, std::uint64_t seed,
+             const std::string& split) {
+            manisoft::scene::SampleRequest q;
+            q.task = manisoft::scene::parse_task(task);
+            q.setting = manisoft::scene::parse_setting(setting);
+            q.split = manisoft::scene::parse_split(split);
+            q.index = index;
+            q.seed = seed;
+            py::gil_scoped_release release;
+            return manisoft::scene::to_json_string(sampler.sample(q));
+          },
+          py::arg("task"), py::arg("setting") = "clean", py::arg("index") = 0, py::arg("seed") = 0, py::arg("split") = "train",
+          "The scene (task, setting, split, index, seed) as manisoft.scene/1 JSON text: the scene make_env's reset builds for them");
+  py::class_<StateRenderer>(m, "Renderer", "Renders a scene in a given state (OpenGL through EGL)")
+      .def(py::init<>())
+      .def("render", &StateRenderer::render, py::arg("scene"), py::arg("rod_nodes"), py::arg("gripper_pose"), py::arg("finger_width"),
+           py::arg("object_poses"), py::arg("camera") = py::none(),
+           "Image (uint8 H x W x 3) of scene JSON text with the rod's nodes ((n+1) x 3), the gripper's pose (4 x 4), its finger width (m) and "
+           "the objects' poses (objects x 4 x 4), e.g. the privileged keys of an observation");
 }

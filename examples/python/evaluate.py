@@ -1,0 +1,495 @@
+#!/usr/bin/env python3
+"""Evaluates a policy on ManiSoft's held-out scenes and writes the paper's tables (issue 16, section 2).
+
+    PYTHONPATH=build/<config>/python /usr/bin/python3 examples/python/evaluate.py \\
+        --task all --setting clean --policy expert --episodes-per-category 20 --seed 0 --out eval/expert
+
+Policies (--policy):
+  expert                 the rule-based expert (privileged: it reads the simulator's state)
+  random                 uniform torques within the actuation limits, S uniform in {0, 1}
+  replay:DIR             the actions saved by an earlier run with --save-actions (DIR/actions/*.npy)
+  python:MODULE:FUNC     FUNC(obs) -> one action (3n+1,) or a chunk (H, 3n+1); obs: {"image": uint8
+                         H x W x 3, "instruction": str}; MODULE is imported (the working directory
+                         and --python-path are searched)
+  ws://HOST:PORT         a policy server speaking openpi's websocket protocol: it sends its metadata on
+                         connect, then answers each msgpack request {"observation/image": H x W x 3
+                         uint8, "prompt": str} with {"actions": H x (3n+1)} (numpy arrays in openpi's
+                         msgpack encoding)
+A chunk's first --chunk-steps actions are executed before the policy is asked again.
+
+Scenes: the evaluation split (never drawn by dataset generation), eval indices 0, 1, 2, ... of each
+task and setting, the first K of each target-object category (STK: K in all); horizon T = 1500.
+Episodes alternate seen and unseen instructions where the scene has them (randomized scenes).
+A policy that raises, returns a malformed action or is slower than --policy-timeout seconds fails
+the episode with that reason; the evaluation goes on.
+
+Output in --out: episodes.csv (one row an episode), results.csv and results.md (ACC % with its 95%
+Wilson interval and #Steps, the mean length of successes, per task, category and setting; seen
+vs unseen instructions; failure reasons), summary.json. Exit 0 when every episode ran (whatever
+its outcome), 1 on an error, 2 on bad flags.
+"""
+import argparse
+import asyncio
+import csv
+import concurrent.futures
+import importlib
+import json
+import math
+import multiprocessing
+import os
+import sys
+import time
+from collections import Counter, defaultdict
+
+import numpy as np
+
+TASKS = ("COLL", "ALN", "STK", "ARR")
+SETTINGS = ("clean", "randomized")
+HORIZON = 1500
+
+
+# ---- statistics
+
+def wilson_interval(successes, n, z=1.959963984540054):
+    """95% Wilson score interval of a binomial proportion (in [0, 1])."""
+    if n == 0:
+        return (0.0, 1.0)
+    p = successes / n
+    denom = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+# ---- scenes
+
+def target_category(scene):
+    """The category of a scene's designated object ("bottle" of "bottle/05"); STK: its bottom item's."""
+    goal, objects = scene["goal"], scene["objects"]
+    if scene["task"] in ("COLL", "ALN"):
+        index = goal["object"]
+    elif scene["task"] == "ARR":
+        index = goal["relations"][0]["objects"][0]
+    else:
+        return "all"
+    return objects[index]["asset_id"].split("/")[0]
+
+
+def plan_episodes(task, setting, per_category, seed, max_scan, sampler):
+    """(task, setting, index, category) of one task and setting: eval indices in order, the first
+    per_category of each target category (STK: per_category in all). Scanning stops when every
+    category met has its episodes and the last max(30, 4 per_category) indices brought no new one."""
+    counts, plan, last_new = Counter(), [], 0
+    for index in range(max_scan):
+        category = target_category(json.loads(sampler.sample(task, setting, index, seed, "eval")))
+        if category not in counts:
+            last_new = index
+        if counts[category] < per_category:
+            counts[category] += 1
+            plan.append((task, setting, index, category))
+        if all(c >= per_category for c in counts.values()) and index - last_new >= max(30, 4 * per_category):
+            break
+    return plan
+
+
+# ---- policies
+
+class PolicyFailure(Exception):
+    """The policy failed an episode: reason is the machine-readable failure."""
+
+    def __init__(self, reason, detail):
+        super().__init__(f"{reason}: {detail}")
+        self.reason = reason
+        self.detail = detail
+
+
+def pack_openpi(obj):
+    """openpi's msgpack encoding of numpy arrays and scalars."""
+    if isinstance(obj, np.ndarray):
+        return {b"__ndarray__": True, b"data": obj.tobytes(), b"dtype": obj.dtype.str, b"shape": obj.shape}
+    if isinstance(obj, np.generic):
+        return {b"__npgeneric__": True, b"data": obj.item(), b"dtype": obj.dtype.str}
+    return obj
+
+
+def unpack_openpi(obj):
+    """Decodes openpi's encoding (and msgpack-numpy's, b"nd") back to numpy."""
+    if b"__ndarray__" in obj:
+        return np.ndarray(buffer=obj[b"data"], dtype=np.dtype(obj[b"dtype"]), shape=obj[b"shape"])
+    if b"__npgeneric__" in obj:
+        return np.dtype(obj[b"dtype"]).type(obj[b"data"])
+    if b"nd" in obj and obj[b"nd"]:
+        return np.frombuffer(obj[b"data"], dtype=np.dtype(obj[b"type"])).reshape(obj[b"shape"])
+    return obj
+
+
+class WebsocketPolicy:
+    """A client of an openpi-style policy server (websockets' asyncio API, Debian's 10.x)."""
+
+    def __init__(self, uri, timeout):
+        import msgpack
+        import websockets
+        self._msgpack, self._websockets, self._uri, self._timeout = msgpack, websockets, uri, timeout
+        self._loop = asyncio.new_event_loop()
+        self._ws = None
+        self.metadata = None
+
+    def _run(self, coroutine):
+        try:
+            return self._loop.run_until_complete(asyncio.wait_for(coroutine, self._timeout))
+        except asyncio.TimeoutError:
+            self.close()
+            raise PolicyFailure("policy_timeout", f"no answer from {self._uri} within {self._timeout} s") from None
+
+    def _connect(self):
+        async def connect():
+            ws = await self._websockets.connect(self._uri, compression=None, max_size=None)
+            metadata = self._msgpack.unpackb(await ws.recv(), object_hook=unpack_openpi)
+            return ws, metadata
+        try:
+            self._ws, self.metadata = self._run(connect())
+        except (OSError, self._websockets.exceptions.WebSocketException) as e:
+            raise PolicyFailure("policy_error", f"cannot connect to {self._uri}: {e}") from None
+
+    def __call__(self, obs):
+        if self._ws is None:
+            self._connect()
+        request = {"observation/image": obs["image"], "prompt": obs["instruction"]}
+
+        async def infer():
+            await self._ws.send(self._msgpack.packb(request, default=pack_openpi))
+            return await self._ws.recv()
+        try:
+            answer = self._run(infer())
+        except self._websockets.exceptions.WebSocketException as e:
+            self.close()
+            raise PolicyFailure("policy_error", f"{self._uri}: {e}") from None
+        if isinstance(answer, str):
+            raise PolicyFailure("policy_error", f"the server reported an error: {answer[:500]}")
+        reply = self._msgpack.unpackb(answer, object_hook=unpack_openpi)
+        if not isinstance(reply, dict) or "actions" not in reply:
+            raise PolicyFailure("bad_action", "the server's reply has no 'actions'")
+        return reply["actions"]
+
+    def close(self):
+        if self._ws is not None:
+            try:
+                self._loop.run_until_complete(asyncio.wait_for(self._ws.close(), 1.0))
+            except Exception:
+                pass
+            self._ws = None
+
+
+class RandomPolicy:
+    def __init__(self, space, seed):
+        self.low, self.high = space["low"], space["high"]
+        self.rng = np.random.default_rng(seed)
+
+    def __call__(self, obs):
+        action = self.rng.uniform(self.low, self.high)
+        action[-1] = float(self.rng.integers(0, 2))
+        return action
+
+
+class ReplayPolicy:
+    """Plays back DIR/actions/<task>_<setting>_<index>.npy (T x (3n+1)), one action a step."""
+
+    def __init__(self, directory):
+        self.directory = directory
+        self.actions, self.step = None, 0
+
+    def start(self, task, setting, index):
+        path = os.path.join(self.directory, "actions", f"{task}_{setting}_{index}.npy")
+        if not os.path.exists(path):
+            raise PolicyFailure("policy_error", f"no recorded actions: {path}")
+        self.actions, self.step = np.load(path), 0
+
+    def __call__(self, obs):
+        if self.step >= len(self.actions):
+            raise PolicyFailure("policy_error", f"the recording ends after {len(self.actions)} actions")
+        self.step += 1
+        return self.actions[self.step - 1]
+
+
+def load_python_policy(spec, extra_path):
+    _, module_name, function_name = spec.split(":", 2)
+    for p in [os.getcwd()] + list(extra_path):
+        if p not in sys.path:
+            sys.path.insert(0, p)
+    module = importlib.import_module(module_name)
+    function = getattr(module, function_name, None)
+    if not callable(function):
+        raise ValueError(f"--policy {spec}: {module_name} has no callable '{function_name}'")
+    return function
+
+
+def check_spec(spec):
+    if spec in ("expert", "random") or spec.startswith("ws://"):
+        return
+    if spec.startswith("replay:") and len(spec) > len("replay:"):
+        return
+    if spec.startswith("python:") and len(spec.split(":")) == 3 and all(spec.split(":")[1:]):
+        return
+    raise ValueError(f"--policy {spec!r}: expected expert, random, replay:DIR, python:MODULE:FUNCTION or ws://HOST:PORT")
+
+
+# ---- episodes
+
+def as_chunk(action, size):
+    """The policy's answer as an (H, size) float64 chunk, or PolicyFailure("bad_action")."""
+    try:
+        a = np.asarray(action, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise PolicyFailure("bad_action", f"not a numeric array ({e})") from None
+    if a.ndim == 1:
+        a = a[None, :]
+    if a.ndim != 2 or a.shape[1] != size or a.shape[0] < 1:
+        raise PolicyFailure("bad_action", f"shape {np.shape(action)}, expected ({size},) or (H, {size})")
+    if not np.all(np.isfinite(a)):
+        raise PolicyFailure("bad_action", "not finite")
+    return a
+
+
+class Worker:
+    """Runs episodes in one process: one environment per (task, setting), one policy."""
+
+    def __init__(self, args):
+        self.args = args
+        self.envs = {}
+        self.policy = None
+        self.current = None
+
+    def env(self, task, setting):
+        import manisoft
+        key = (task, setting)
+        if key not in self.envs:
+            width, height = self.args.image_size
+            needs_image = not (self.args.policy in ("expert", "random") or self.args.policy.startswith("replay:"))
+            self.envs[key] = manisoft.make_env(task, setting, seed=self.args.seed, split="eval", render=needs_image,
+                                               camera={"width": width, "height": height})
+        return self.envs[key]
+
+    def make_policy(self, env):
+        spec = self.args.policy
+        if spec == "expert":
+            return lambda obs: self.current.expert_action()
+        if spec == "random":
+            return RandomPolicy(env.action_space, self.args.seed)
+        if spec.startswith("replay:"):
+            return ReplayPolicy(spec[len("replay:"):])
+        if spec.startswith("python:"):
+            return load_python_policy(spec, self.args.python_path)
+        return WebsocketPolicy(spec, self.args.policy_timeout)
+
+    def run(self, episode):
+        task, setting, index, category, number = episode
+        env = self.current = self.env(task, setting)
+        if self.policy is None:
+            self.policy = self.make_policy(env)
+        policy = self.policy
+        instruction = "seen" if number % 2 == 0 else "unseen"
+        t0 = time.perf_counter()
+        obs, info = env.reset(seed=self.args.seed, options={"index": index, "split": "eval", "instruction": instruction,
+                                                          "instruction_index": number // 2})
+        if isinstance(policy, ReplayPolicy):
+            policy.start(task, setting, index)
+        size = env.action_space["shape"][0]
+        actions, failure, detail = [], info["failure"], ""
+        chunk, used = None, 0
+        while not info["done"]:
+            if chunk is None or used >= min(len(chunk), self.args.chunk_steps):
+                try:
+                    start = time.perf_counter()
+                    answer = policy(obs)
+                    if time.perf_counter() - start > self.args.policy_timeout:
+                        raise PolicyFailure("policy_timeout", f"the policy took {time.perf_counter() - start:.1f} s > {self.args.policy_timeout} s")
+                    chunk, used = as_chunk(answer, size), 0
+                except PolicyFailure as e:
+                    failure, detail = e.reason, e.detail
+                    break
+                except Exception as e:  # the policy's own error: the episode fails, the evaluation goes on
+                    failure, detail = "policy_error", f"{type(e).__name__}: {e}"
+                    break
+            action = chunk[used]
+            used += 1
+            actions.append(action)
+            obs, _, terminated, truncated, info = env.step(action)
+            failure = info["failure"]
+        if self.args.save_actions:
+            path = os.path.join(self.args.out, "actions", f"{task}_{setting}_{index}.npy")
+            tmp = path + ".tmp.npy"
+            np.save(tmp, np.asarray(actions, dtype=np.float64).reshape(-1, size))
+            os.replace(tmp, path)
+        success = bool(info["success"]) and failure is None
+        return {"task": task, "setting": setting, "category": category, "index": index, "seed": self.args.seed,
+                "instruction_kind": info["instruction_kind"], "success": success, "success_at_end": bool(info["success_at_end"]),
+                "steps": int(info["steps"]), "failure": "" if success else (failure or "policy_error"), "detail": detail,
+                "wall_s": round(time.perf_counter() - t0, 3)}
+
+
+_worker = None
+
+
+def _worker_init(args):
+    global _worker
+    _worker = Worker(args)
+
+
+def _worker_run(episode):
+    return _worker.run(episode)
+
+
+# ---- tables
+
+def table_rows(episodes):
+    """Per (task, setting, category) and per (task, setting) ("all"): n, successes, ACC, Wilson, #Steps."""
+    groups = defaultdict(list)
+    for e in episodes:
+        groups[(e["task"], e["setting"], e["category"])].append(e)
+        if e["category"] != "all":
+            groups[(e["task"], e["setting"], "all")].append(e)
+        groups[("all", e["setting"], "all")].append(e)
+    rows = []
+    order = {t: i for i, t in enumerate(TASKS + ("all",))}
+    for (task, setting, category), eps in sorted(groups.items(), key=lambda kv: (kv[0][1], order[kv[0][0]], kv[0][2] != "all", kv[0][2])):
+        ok = [e for e in eps if e["success"]]
+        low, high = wilson_interval(len(ok), len(eps))
+        rows.append({"task": task, "setting": setting, "category": category, "episodes": len(eps), "successes": len(ok),
+                     "acc": 100.0 * len(ok) / len(eps), "acc_low": 100.0 * low, "acc_high": 100.0 * high,
+                     "mean_steps": (sum(e["steps"] for e in ok) / len(ok)) if ok else float("nan")})
+    return rows
+
+
+def write_outputs(out, args, episodes, wall):
+    fields = ["task", "setting", "category", "index", "seed", "instruction_kind", "success", "success_at_end", "steps", "failure",
+              "detail", "wall_s"]
+    write_csv(os.path.join(out, "episodes.csv"), fields, episodes)
+    rows = table_rows(episodes)
+    write_csv(os.path.join(out, "results.csv"), list(rows[0].keys()) if rows else [], rows)
+    lines = [f"# ManiSoft evaluation: policy `{args.policy}`", "",
+             f"Held-out (eval) scenes, seed {args.seed}, " + (f"eval indices {args.indices}" if args.indices else
+             f"up to {args.episodes_per_category or '20 (clean) / 40 (randomized)'} episodes per target category") + ", "
+             f"horizon {HORIZON}; {len(episodes)} episodes in {wall:.0f} s. ACC: success % with its 95% Wilson interval; "
+             "#Steps: mean length of the successful episodes.", ""]
+    for setting in args.settings:
+        lines += [f"## {setting}", "", "| task | category | episodes | ACC % | 95% interval | #Steps |", "|---|---|---|---|---|---|"]
+        for r in rows:
+            if r["setting"] == setting:
+                steps = "-" if math.isnan(r["mean_steps"]) else f"{r['mean_steps']:.0f}"
+                name = f"**{r['category']}**" if r["category"] == "all" else r["category"]
+                lines.append(f"| {r['task']} | {name} | {r['episodes']} | {r['acc']:.1f} | {r['acc_low']:.1f}-{r['acc_high']:.1f} | {steps} |")
+        lines.append("")
+    lines += ["## Instructions seen vs unseen in training", "", "| setting | instructions | episodes | ACC % |", "|---|---|---|---|"]
+    kinds = defaultdict(list)
+    for e in episodes:
+        kinds[(e["setting"], e["instruction_kind"])].append(e["success"])
+    for (setting, kind), s in sorted(kinds.items()):
+        lines.append(f"| {setting} | {kind} | {len(s)} | {100.0 * sum(s) / len(s):.1f} |")
+    lines += ["", "## Failure reasons", "", "| task | setting | reason | episodes |", "|---|---|---|---|"]
+    for (task, setting, reason), n in sorted(Counter((e["task"], e["setting"], e["failure"]) for e in episodes if not e["success"]).items()):
+        lines.append(f"| {task} | {setting} | {reason} | {n} |")
+    write_text(os.path.join(out, "results.md"), "\n".join(lines) + "\n")
+    summary = {"policy": args.policy, "seed": args.seed, "episodes": len(episodes), "wall_s": round(wall, 1),
+               "success_rate": sum(e["success"] for e in episodes) / max(1, len(episodes)),
+               "tables": [{k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in r.items()} for r in rows if r["category"] == "all"]}
+    write_text(os.path.join(out, "summary.json"), json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    return rows
+
+
+def write_text(path, text):
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def write_csv(path, fields, rows):
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{v:.3f}" if isinstance(v, float) else v) for k, v in r.items()})
+    os.replace(tmp, path)
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(description="Evaluate a policy on ManiSoft's held-out scenes (the paper's tables)")
+    p.add_argument("--task", default="all", choices=TASKS + ("all",))
+    p.add_argument("--setting", default="clean", choices=SETTINGS + ("all",))
+    p.add_argument("--policy", default="expert", help="expert | random | replay:DIR | python:MODULE:FUNCTION | ws://HOST:PORT")
+    p.add_argument("--episodes-per-category", type=int, default=None,
+                   help="episodes per target category (default: the paper's protocol, 20 clean and 40 randomized)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", required=True)
+    p.add_argument("--jobs", type=int, default=1, help="worker processes")
+    p.add_argument("--chunk-steps", type=int, default=1, help="actions of a chunk executed before asking the policy again")
+    p.add_argument("--policy-timeout", type=float, default=60.0, help="seconds a policy call may take")
+    p.add_argument("--image-size", type=int, nargs=2, default=[514, 514], metavar=("W", "H"))
+    p.add_argument("--save-actions", action="store_true", help="write each episode's actions to OUT/actions/ (for replay:OUT)")
+    p.add_argument("--python-path", action="append", default=[], help="extra directory to import python: policies from")
+    p.add_argument("--max-scan", type=int, default=None, help="eval indices scanned per task and setting to fill the categories")
+    p.add_argument("--indices", type=int, nargs="+", default=None, help="run these eval indices of each task and setting instead")
+    args = p.parse_args(argv)
+    try:
+        check_spec(args.policy)
+    except ValueError as e:
+        p.error(str(e))
+    for name in ("jobs", "chunk_steps"):
+        if getattr(args, name) < 1:
+            p.error(f"--{name.replace('_', '-')} must be >= 1")
+    if args.episodes_per_category is not None and args.episodes_per_category < 1:
+        p.error("--episodes-per-category must be >= 1")
+    if not args.policy_timeout > 0:
+        p.error("--policy-timeout must be > 0")
+    args.tasks = TASKS if args.task == "all" else (args.task,)
+    args.settings = SETTINGS if args.setting == "all" else (args.setting,)
+    return args
+
+
+def main(argv=None):
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    os.makedirs(args.out, exist_ok=True)
+    if args.save_actions:
+        os.makedirs(os.path.join(args.out, "actions"), exist_ok=True)
+    t0 = time.perf_counter()
+    import manisoft
+    sampler = manisoft.SceneSampler()
+    plan = []
+    for setting in args.settings:
+        k = args.episodes_per_category or (20 if setting == "clean" else 40)
+        for task in args.tasks:
+            if args.indices:
+                plan += [(task, setting, i, target_category(json.loads(sampler.sample(task, setting, i, args.seed, "eval")))) for i in args.indices]
+            else:
+                plan += plan_episodes(task, setting, k, args.seed, args.max_scan or 60 * k, sampler)
+    episodes_in = [p + (n,) for n, p in enumerate(plan)]
+    print(f"{len(plan)} episodes ({', '.join(f'{t} {s}: {sum(1 for p in plan if p[:2] == (t, s))}' for t in args.tasks for s in args.settings)})",
+          flush=True)
+    results = []
+    if args.jobs == 1:
+        _worker_init(args)
+        run = map(_worker_run, episodes_in)
+    else:
+        pool = concurrent.futures.ProcessPoolExecutor(args.jobs, mp_context=multiprocessing.get_context("spawn"),
+                                                      initializer=_worker_init, initargs=(args,))
+        run = pool.map(_worker_run, episodes_in)
+    for r in run:
+        results.append(r)
+        done = len(results)
+        ok = sum(e["success"] for e in results)
+        print(f"[{done}/{len(plan)}] {r['task']} {r['setting']} {r['category']} index {r['index']}: "
+              f"{'success' if r['success'] else r['failure']} after {r['steps']} steps ({r['wall_s']:.1f} s); success so far {ok}/{done}",
+              flush=True)
+    if args.jobs > 1:
+        pool.shutdown()
+    rows = write_outputs(args.out, args, results, time.perf_counter() - t0)
+    for r in rows:
+        if r["category"] == "all":
+            print(f"{r['task']:>4} {r['setting']:<10} ACC {r['acc']:5.1f}% [{r['acc_low']:.1f}, {r['acc_high']:.1f}] over {r['episodes']} episodes")
+    print(f"tables: {os.path.join(args.out, 'results.md')}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

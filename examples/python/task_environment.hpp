@@ -1,0 +1,419 @@
+// The benchmark's task environment for Python (issue 16, section 1): task::TaskEnv (one ManiSoft
+// task COLL/ALN/STK/ARR in the arm world, success predicate, failure reasons) with scenes from
+// scene::SceneSampler, the camera image from the in-process OpenGL renderer (render::GlRenderer
+// over examples/render/spec_render_scene.hpp), and the rule-based expert (task::Expert) for
+// collecting data or as an upper bound. Gymnasium's signatures, no gymnasium dependency.
+//
+// Action (the paper's, section 3.2): one float vector of 3n + 1 entries, the n x 3 material-frame
+// element torques flattened row by row (element 0 is the clamped base: its bounds are 0), then the
+// gripper state S (>= 0.5 closed, below open). Torques are clamped to the actuation limits; NaN,
+// wrong shape or a non-real dtype raise ValueError and change nothing.
+// Observation: "instruction" (str) and, when rendering, "image" (uint8 H x W x 3, a fresh array a
+// step, handed over without a copy); with privileged=True also "end_effector" (4 x 4, the rod tip's
+// frame), "gripper_pose" (4 x 4, the gripper body: what Renderer.render takes), "rod_nodes" ((n+1) x 3), "gripper_width" (m), "gripper_state" (S), "object_poses"
+// (objects x 4 x 4, asset frame -> world).
+// Reward: 1 at the step the task succeeds, else 0. terminated: success or a terminal failure
+// (diverged, object_off_table, scene_invalid); truncated: the horizon (T = 1500) reached.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "../render/spec_render_scene.hpp"
+#include "manisoft/render/gl_renderer.hpp"
+#include "manisoft/scene/scene_json.hpp"
+#include "manisoft/scene/scene_sampler.hpp"
+#include "manisoft/task/expert.hpp"
+#include "manisoft/task/task_env.hpp"
+
+namespace manisoft_py {
+
+namespace py = pybind11;
+namespace ms = manisoft;
+
+/// A 4 x 4 homogeneous matrix of a pose.
+inline py::array_t<double> matrix_of(const ms::math::Pose<double>& p) {
+  py::array_t<double> out({4, 4});
+  auto v = out.mutable_unchecked<2>();
+  const Eigen::Matrix4d m = p.matrix();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) v(r, c) = m(r, c);
+  return out;
+}
+
+/// A pose from a 4 x 4 matrix (its rotation block re-orthonormalised is not attempted: it is checked).
+inline ms::math::Pose<double> pose_of(const py::handle& h, const std::string& what) {
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
+  if (!a || a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) throw py::value_error(what + " must be a 4 x 4 matrix");
+  const auto v = a.unchecked<2>();
+  ms::math::Pose<double> p;
+  for (int r = 0; r < 3; ++r) {
+    p.translation(r) = v(r, 3);
+    for (int c = 0; c < 3; ++c) p.rotation(r, c) = v(r, c);
+  }
+  if (!p.is_finite()) throw py::value_error(what + " is not finite");
+  if ((p.rotation.transpose() * p.rotation - Eigen::Matrix3d::Identity()).norm() > 1e-6)
+    throw py::value_error(what + ": its rotation block is not orthonormal");
+  return p;
+}
+
+/// A camera from a dict (keys position, look_at, up, fov_y_deg, width, height; others refused),
+/// starting from `base`.
+inline ms::render::Camera camera_of(const py::dict& d, ms::render::Camera base) {
+  auto vec = [](const py::handle& h, const std::string& key) {
+    const auto v = h.cast<std::vector<double>>();
+    if (v.size() != 3) throw py::value_error("camera['" + key + "'] must have 3 entries");
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+  };
+  for (const auto& [k, v] : d) {
+    const std::string key = py::str(k);
+    if (key == "position") base.position = vec(v, key);
+    else if (key == "look_at") base.look_at = vec(v, key);
+    else if (key == "up") base.up = vec(v, key);
+    else if (key == "fov_y_deg") base.fov_y_deg = v.cast<double>();
+    else if (key == "width") base.width = v.cast<int>();
+    else if (key == "height") base.height = v.cast<int>();
+    else throw py::value_error("camera: unknown key '" + key + "' (position, look_at, up, fov_y_deg, width, height)");
+  }
+  ms::render::validate(base);
+  return base;
+}
+
+/// The pixels of a render handed to numpy without a copy: the array owns the moved buffer.
+inline py::array_t<std::uint8_t> image_array(std::vector<std::uint8_t>&& rgb, int width, int height) {
+  auto* owned = new std::vector<std::uint8_t>(std::move(rgb));
+  py::capsule free_when_done(owned, [](void* p) { delete static_cast<std::vector<std::uint8_t>*>(p); });
+  return py::array_t<std::uint8_t>({height, width, 3}, owned->data(), free_when_done);
+}
+
+/// The renderer of one scene: its description once, then a frame per state.
+class SceneRenderer {
+ public:
+  SceneRenderer(const ms::scene::SceneSpec& spec, const ms::scene::AssetLibrary& library, const std::optional<ms::render::Camera>& camera,
+                ms::render::GlRenderer& gl)
+      : scene_(ms::render::spec::make_spec_scene(spec, library)), gl_(&gl) {
+    if (camera) scene_.scene.cameras = {*camera};
+    for (std::size_t i = 0; i < spec.objects.size(); ++i) object_names_.push_back("object" + std::to_string(i));
+    gl_->set_scene(scene_.scene);
+  }
+
+  /// The frame of a state: rod centreline, gripper body pose and opening, object poses.
+  void set_state(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3>>& rod_nodes, const ms::math::Pose<double>& gripper,
+                 double finger_width, const std::vector<ms::math::Pose<double>>& objects) {
+    frame_ = scene_.frame;
+    frame_.rod.nodes = rod_nodes;
+    frame_.rod.directors.resize(0, 9);
+    ms::render::tabletop::set_gripper(scene_, frame_, gripper, finger_width);
+    for (std::size_t i = 0; i < scene_.scene.instances.size(); ++i) {
+      const std::string& n = scene_.scene.instances[i].name;
+      const std::string name = n.substr(0, n.find(' '));
+      if (name.rfind("object", 0) != 0) continue;
+      const std::size_t k = std::stoul(name.substr(6));
+      if (k < objects.size()) frame_.instance_poses[i] = objects[k];
+    }
+  }
+
+  /// Renders the current frame (the GIL released); the image as a numpy array.
+  py::array_t<std::uint8_t> render() {
+    {
+      py::gil_scoped_release release;
+      gl_->render_into(frame_, out_);
+    }
+    const int w = out_.width, h = out_.height;
+    return image_array(std::move(out_.rgb), w, h);
+  }
+
+ private:
+  ms::render::tabletop::TabletopScene scene_;
+  ms::render::GlRenderer* gl_;
+  ms::render::FrameState frame_;
+  ms::render::RenderOutput out_;
+  std::vector<std::string> object_names_;
+};
+
+/// A GlRenderer for the image a policy sees: shadows on, only colour read back.
+inline std::unique_ptr<ms::render::GlRenderer> make_policy_renderer() {
+  ms::render::GlRendererOptions o;
+  o.read_depth = false;
+  o.read_mask = false;
+  return std::make_unique<ms::render::GlRenderer>(o);
+}
+
+class TaskEnvironment {
+ public:
+  using Array3 = ms::task::TaskEnv::Array3;
+
+  TaskEnvironment(const std::string& task, const std::string& setting, std::uint64_t seed, bool render, const std::optional<py::dict>& camera,
+                  bool privileged, const std::string& split)
+      : env_(sampler_.library()), expert_(env_), seed_(seed), render_(render), privileged_(privileged) {
+    request_.task = ms::scene::parse_task(task);
+    request_.setting = ms::scene::parse_setting(setting);
+    request_.split = ms::scene::parse_split(split);
+    if (camera) camera_ = camera_of(*camera, ms::render::Camera{});
+    n_ = env_.arm_model().rod.n_elements;
+    torques_ = Array3::Zero(n_, 3);
+  }
+
+  /// options: "index" (scene index; default: the next one), "split" ("train" | "eval"),
+  /// "instruction" ("canonical" | "seen" | "unseen"), "instruction_index" (which of them, modulo
+  /// their number), "scene" (a scene JSON string instead of sampling).
+  py::tuple reset(std::optional<std::uint64_t> seed, const std::optional<py::dict>& options) {
+    check_open();
+    if (seed) seed_ = *seed;
+    ms::scene::SampleRequest q = request_;
+    q.seed = seed_;
+    q.index = next_index_;
+    std::string instruction_kind = "canonical";
+    std::size_t instruction_index = 0;
+    std::optional<std::string> scene_json;
+    if (options) {
+      for (const auto& [k, v] : *options) {
+        const std::string key = py::str(k);
+        if (key == "index") q.index = v.cast<std::uint64_t>();
+        else if (key == "split") q.split = ms::scene::parse_split(v.cast<std::string>());
+        else if (key == "instruction") instruction_kind = v.cast<std::string>();
+        else if (key == "instruction_index") instruction_index = v.cast<std::size_t>();
+        else if (key == "scene") scene_json = v.cast<std::string>();
+        else throw py::value_error("reset: unknown option '" + key + "' (index, split, instruction, instruction_index, scene)");
+      }
+    }
+    if (instruction_kind != "canonical" && instruction_kind != "seen" && instruction_kind != "unseen")
+      throw py::value_error("reset: option 'instruction' = '" + instruction_kind + "' must be 'canonical', 'seen' or 'unseen'");
+    {
+      py::gil_scoped_release release;
+      if (scene_json) {
+        spec_ = ms::scene::parse_scene(*scene_json, "reset(options['scene'])");
+        ms::scene::require_consistent(spec_, sampler_.library(), "reset(options['scene'])");
+      } else {
+        spec_ = sampler_.sample(q);
+      }
+      env_.reset(spec_);
+      expert_.reset();
+    }
+    next_index_ = q.index + 1;
+    const auto& list = instruction_kind == "seen" ? spec_.instructions_seen : instruction_kind == "unseen" ? spec_.instructions_unseen : std::vector<std::string>{};
+    instruction_ = list.empty() ? spec_.instruction : list[instruction_index % list.size()];
+    instruction_kind_ = list.empty() ? "canonical" : instruction_kind;
+    if (render_) {
+      if (!gl_) gl_ = make_policy_renderer();
+      renderer_.emplace(spec_, sampler_.library(), camera_ ? camera_ : std::optional<ms::render::Camera>(spec_.cameras.front()), *gl_);
+    }
+    started_ = true;
+    return py::make_tuple(observation(), info());
+  }
+
+  py::tuple step(const py::array& action) {
+    check_started();
+    if (env_.done()) throw std::runtime_error("step: the episode is over (" + std::to_string(env_.info().step) + " steps); call reset()");
+    int s = read_action(action, torques_);
+    {
+      py::gil_scoped_release release;
+      env_.step(torques_, s);
+    }
+    const auto& i = env_.info();
+    const bool terminal_failure = i.done && !i.success && i.failure != ms::task::FailureReason::timeout &&
+                                  i.failure != ms::task::FailureReason::object_dropped && i.failure != ms::task::FailureReason::arm_hit_obstacle;
+    const bool terminated = i.success || terminal_failure;
+    const bool truncated = i.done && !terminated;
+    return py::make_tuple(observation(), i.success ? 1.0 : 0.0, terminated, truncated, info());
+  }
+
+  /// The expert's action for the current state (privileged: it reads the world).
+  py::array_t<double> expert_action() {
+    check_started();
+    int s = 0;
+    {
+      py::gil_scoped_release release;
+      expert_.act(torques_, s);
+    }
+    py::array_t<double> out(3 * n_ + 1);
+    auto v = out.mutable_unchecked<1>();
+    for (int k = 0; k < n_; ++k)
+      for (int c = 0; c < 3; ++c) v(3 * k + c) = torques_(k, c);
+    v(3 * n_) = s;
+    return out;
+  }
+
+  /// The current frame from the environment's camera (any time after reset; needs render=True).
+  py::array_t<std::uint8_t> render() {
+    check_started();
+    if (!renderer_) throw std::runtime_error("render: make the environment with render=True");
+    update_frame();
+    return renderer_->render();
+  }
+
+  py::dict action_space() const {
+    const ms::rod::ActuationLimits<double> lim = ms::world::ArmWorldSettings{}.limits;  // TaskEnv's world keeps the defaults
+    py::array_t<double> low(3 * n_ + 1), high(3 * n_ + 1);
+    auto l = low.mutable_unchecked<1>();
+    auto h = high.mutable_unchecked<1>();
+    for (int k = 0; k < n_; ++k)
+      for (int c = 0; c < 3; ++c) {
+        h(3 * k + c) = k == 0 ? 0.0 : lim.limit(c);
+        l(3 * k + c) = -h(3 * k + c);
+      }
+    l(3 * n_) = 0.0;
+    h(3 * n_) = 1.0;
+    py::dict d;
+    d["shape"] = py::make_tuple(3 * n_ + 1);
+    d["dtype"] = "float64";
+    d["low"] = low;
+    d["high"] = high;
+    d["layout"] = "element torques (n x 3, material frame d1 d2 d3, row by row; element 0 fixed at 0) then S (>= 0.5 closed)";
+    return d;
+  }
+
+  py::dict observation_space() const {
+    py::dict d;
+    d["instruction"] = py::make_tuple(py::make_tuple(), "str");
+    if (render_) {
+      const auto& cam = camera_ ? *camera_ : ms::render::Camera{};
+      d["image"] = py::make_tuple(py::make_tuple(cam.height, cam.width, 3), "uint8");
+    }
+    if (privileged_) {
+      d["end_effector"] = py::make_tuple(py::make_tuple(4, 4), "float64");
+      d["gripper_pose"] = py::make_tuple(py::make_tuple(4, 4), "float64");
+      d["rod_nodes"] = py::make_tuple(py::make_tuple(n_ + 1, 3), "float64");
+      d["gripper_width"] = py::make_tuple(py::make_tuple(), "float64");
+      d["gripper_state"] = py::make_tuple(py::make_tuple(), "int64");
+      d["object_poses"] = py::make_tuple(py::make_tuple(-1, 4, 4), "float64");  // -1: the scene's object count
+    }
+    return d;
+  }
+
+  void close() {
+    renderer_.reset();
+    gl_.reset();
+    closed_ = true;
+  }
+  int horizon() const { return env_.config().horizon; }
+  int n_elements() const { return n_; }
+  std::string scene_json() const {
+    check_started();
+    return ms::scene::to_json_string(spec_);
+  }
+  std::string expert_phase() const { return std::string(ms::task::to_string(expert_.phase())); }
+
+ private:
+  void check_open() const {
+    if (closed_) throw std::runtime_error("the environment is closed");
+  }
+  void check_started() const {
+    check_open();
+    if (!started_) throw std::runtime_error("call reset() before step()");
+  }
+
+  /// Reads a flat action into `torques`; returns S. Refuses before anything changes.
+  int read_action(const py::array& action, Array3& torques) const {
+    const char kind = action.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u')
+      throw py::value_error("step: action dtype must be real (float64 preferred), got " + std::string(py::str(action.dtype())));
+    if (action.ndim() != 1 || action.shape(0) != 3 * n_ + 1)
+      throw py::value_error("step: action must have shape (" + std::to_string(3 * n_ + 1) + ",) (n x 3 torques then S), got " +
+                            std::string(py::str(py::handle(action).attr("shape"))));
+    const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(action);
+    const auto v = values.unchecked<1>();
+    for (py::ssize_t i = 0; i < v.shape(0); ++i)
+      if (!std::isfinite(v(i)))
+        throw py::value_error("step: action entry " + std::to_string(i) +
+                              (i < 3 * n_ ? " (element " + std::to_string(i / 3) + ", component d" + std::to_string(i % 3 + 1) + ")" : std::string(" (S)")) +
+                              " is not finite");
+    for (int k = 0; k < n_; ++k)
+      for (int c = 0; c < 3; ++c) torques(k, c) = v(3 * k + c);
+    return v(3 * n_) >= 0.5 ? 1 : 0;
+  }
+
+  std::vector<ms::math::Pose<double>> object_poses() const {
+    std::vector<ms::math::Pose<double>> out;
+    for (const auto& o : env_.snapshot().objects) out.push_back(o.pose);
+    return out;
+  }
+
+  ms::math::Pose<double> gripper_pose() const {
+    const auto& w = env_.world();
+    return {w.rigid().orientation(w.gripper_body()).toRotationMatrix(), w.rigid().position(w.gripper_body())};
+  }
+
+  void update_frame() {
+    const auto& w = env_.world();
+    renderer_->set_state(w.rod().state().positions, gripper_pose(), w.gripper().finger_width(), object_poses());
+  }
+
+  py::dict observation() {
+    py::dict o;
+    o["instruction"] = instruction_;
+    if (renderer_) {
+      update_frame();
+      o["image"] = renderer_->render();
+    }
+    if (privileged_) {
+      const auto& w = env_.world();
+      const auto frame = w.soft().end_effector_frame();
+      o["end_effector"] = matrix_of(ms::math::Pose<double>{frame.rotation, frame.position});
+      o["gripper_pose"] = matrix_of(gripper_pose());
+      const auto& x = w.rod().state().positions;
+      py::array_t<double> nodes({static_cast<py::ssize_t>(x.rows()), py::ssize_t{3}});
+      auto nv = nodes.mutable_unchecked<2>();
+      for (Eigen::Index i = 0; i < x.rows(); ++i)
+        for (int c = 0; c < 3; ++c) nv(i, c) = x(i, c);
+      o["rod_nodes"] = nodes;
+      o["gripper_width"] = w.gripper().finger_width();
+      o["gripper_state"] = w.gripper().state();
+      const auto poses = object_poses();
+      py::array_t<double> objects({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}, py::ssize_t{4}});
+      auto ov = objects.mutable_unchecked<3>();
+      for (std::size_t i = 0; i < poses.size(); ++i) {
+        const Eigen::Matrix4d m = poses[i].matrix();
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 4; ++c) ov(static_cast<py::ssize_t>(i), r, c) = m(r, c);
+      }
+      o["object_poses"] = objects;
+    }
+    return o;
+  }
+
+  py::dict info() const {
+    const auto& i = env_.info();
+    py::dict d;
+    d["success"] = i.success;
+    d["success_at_end"] = env_.success_at_end();
+    d["steps"] = i.step;
+    d["done"] = i.done;
+    d["failure"] = i.done && !i.success ? py::object(py::str(std::string(ms::task::to_string(i.failure)))) : py::object(py::none());
+    d["clamped"] = i.clamped;
+    d["task"] = std::string(ms::scene::to_string(spec_.task));
+    d["setting"] = std::string(ms::scene::to_string(spec_.setting));
+    d["split"] = std::string(ms::scene::to_string(spec_.split));
+    d["index"] = spec_.index;
+    d["seed"] = spec_.seed;
+    d["instruction_kind"] = instruction_kind_;
+    return d;
+  }
+
+  ms::scene::SceneSampler sampler_;
+  ms::task::TaskEnv env_;
+  ms::task::Expert expert_;
+  ms::scene::SampleRequest request_;
+  std::uint64_t seed_;
+  std::uint64_t next_index_ = 0;
+  bool render_;
+  bool privileged_;
+  std::optional<ms::render::Camera> camera_;
+  std::unique_ptr<ms::render::GlRenderer> gl_;
+  std::optional<SceneRenderer> renderer_;
+  ms::scene::SceneSpec spec_;
+  std::string instruction_, instruction_kind_ = "canonical";
+  int n_ = 0;
+  Array3 torques_;
+  bool started_ = false;
+  bool closed_ = false;
+};
+
+}  // namespace manisoft_py
