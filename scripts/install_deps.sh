@@ -10,6 +10,8 @@ packages+=(libassimp-dev nlohmann-json3-dev)
 packages+=(libhdf5-dev python3-h5py python3-numpy)
 # the Python module (pybind11, for Debian's /usr/bin/python3)
 packages+=(pybind11-dev python3-dev)
+# the evaluation harness's policy-server client (openpi's websocket + msgpack protocol)
+packages+=(python3-websockets python3-msgpack python3-msgpack-numpy)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -30,6 +30,7 @@ its outcome), 1 on an error, 2 on bad flags.
 """
 import argparse
 import asyncio
+import atexit
 import csv
 import concurrent.futures
 import importlib
@@ -171,19 +172,28 @@ class WebsocketPolicy:
             raise PolicyFailure("bad_action", "the server's reply has no 'actions'")
         return reply["actions"]
 
-    def close(self):
+    def close(self, final=False):
+        """Closes the connection (the next call reconnects); final: also the event loop."""
         if self._ws is not None:
             try:
                 self._loop.run_until_complete(asyncio.wait_for(self._ws.close(), 1.0))
-            except Exception:
-                pass
+            except (asyncio.TimeoutError, OSError, self._websockets.exceptions.WebSocketException):
+                pass  # the server is gone or slow: nothing left to close cleanly
             self._ws = None
+        if final:
+            self._loop.close()
 
 
 class RandomPolicy:
+    """Uniform actions; each episode's stream is seeded by (seed, task, setting, index), so the
+    result does not depend on which worker runs it."""
+
     def __init__(self, space, seed):
-        self.low, self.high = space["low"], space["high"]
-        self.rng = np.random.default_rng(seed)
+        self.low, self.high, self.seed = space["low"], space["high"], seed
+        self.rng = None
+
+    def start(self, task, setting, index):
+        self.rng = np.random.default_rng([self.seed, TASKS.index(task), SETTINGS.index(setting), index])
 
     def __call__(self, obs):
         action = self.rng.uniform(self.low, self.high)
@@ -291,7 +301,7 @@ class Worker:
         t0 = time.perf_counter()
         obs, info = env.reset(seed=self.args.seed, options={"index": index, "split": "eval", "instruction": instruction,
                                                           "instruction_index": number // 2})
-        if isinstance(policy, ReplayPolicy):
+        if hasattr(policy, "start"):
             policy.start(task, setting, index)
         size = env.action_space["shape"][0]
         actions, failure, detail = [], info["failure"], ""
@@ -327,12 +337,20 @@ class Worker:
                 "wall_s": round(time.perf_counter() - t0, 3)}
 
 
+    def close(self):
+        if isinstance(self.policy, WebsocketPolicy):
+            self.policy.close(final=True)
+        for env in self.envs.values():
+            env.close()
+
+
 _worker = None
 
 
 def _worker_init(args):
     global _worker
     _worker = Worker(args)
+    atexit.register(_worker.close)
 
 
 def _worker_run(episode):
@@ -483,6 +501,9 @@ def main(argv=None):
               flush=True)
     if args.jobs > 1:
         pool.shutdown()
+    else:
+        atexit.unregister(_worker.close)
+        _worker.close()
     rows = write_outputs(args.out, args, results, time.perf_counter() - t0)
     for r in rows:
         if r["category"] == "all":

@@ -96,8 +96,8 @@ class ReachEnvTest(unittest.TestCase):
         env.close()
         with self.assertRaisesRegex(RuntimeError, "closed"):
             env.step(np.zeros((20, 3)))
-        with self.assertRaisesRegex(ValueError, "unknown environment 'COLL'"):
-            manisoft.make_env("COLL")
+        with self.assertRaisesRegex(ValueError, "unknown environment 'PICK'"):
+            manisoft.make_env("PICK")
         with self.assertRaisesRegex(ValueError, "unknown target set"):
             manisoft.make_env("reach", target_set="moon")
 

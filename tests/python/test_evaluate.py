@@ -1,0 +1,186 @@
+"""The evaluation harness (examples/python/evaluate.py) on tiny runs: the expert succeeding and
+replayed from its saved actions, Python policies that raise or answer malformed actions, action
+chunks, a policy server on a loopback port speaking openpi's websocket protocol, worker processes
+giving the serial result, and the Wilson interval against textbook values."""
+import asyncio
+import csv
+import json
+import os
+import shutil
+import socket
+import tempfile
+import threading
+import unittest
+
+import msgpack
+import numpy as np
+import websockets
+
+import eval_policies
+import evaluate
+
+
+def episodes(out):
+    with open(os.path.join(out, "episodes.csv")) as f:
+        return list(csv.DictReader(f))
+
+
+class PolicyServer:
+    """An openpi-style policy server: metadata on connect, then {"actions": H x 61} per request."""
+
+    def __init__(self, chunk, delay=0.0):
+        self.chunk, self.delay, self.requests = chunk, delay, []
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            self.port = s.getsockname()[1]
+        self.loop = asyncio.new_event_loop()
+        self.ready = threading.Event()
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+        self.ready.wait(10)
+
+    async def _handler(self, ws, path=None):
+        await ws.send(msgpack.packb({"policy": "zeros", "action_dim": 61}, default=evaluate.pack_openpi))
+        async for message in ws:
+            request = msgpack.unpackb(message, object_hook=evaluate.unpack_openpi)
+            self.requests.append((request["observation/image"].shape, request["observation/image"].dtype, request["prompt"]))
+            await asyncio.sleep(self.delay)
+            if ws.closed:
+                return  # the client gave up waiting (the slow-server test)
+            await ws.send(msgpack.packb({"actions": np.zeros((self.chunk, 61), np.float32)}, default=evaluate.pack_openpi))
+
+    def _serve(self):
+        asyncio.set_event_loop(self.loop)
+        self.server = self.loop.run_until_complete(websockets.serve(self._handler, "127.0.0.1", self.port, compression=None, max_size=None))
+        self.ready.set()
+        self.loop.run_forever()
+
+    def stop(self):
+        async def shutdown():
+            self.server.close()
+            await self.server.wait_closed()
+        asyncio.run_coroutine_threadsafe(shutdown(), self.loop).result(10)
+        self.loop.call_soon_threadsafe(self.loop.stop)
+        self.thread.join(5)
+        self.loop.close()
+
+
+class EvaluateTest(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="manisoft_eval_")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def out(self, name):
+        return os.path.join(self.dir, name)
+
+    def test_wilson_interval_textbook_values(self):
+        low, high = evaluate.wilson_interval(8, 10)
+        self.assertAlmostEqual(low, 0.4902, places=4)
+        self.assertAlmostEqual(high, 0.9433, places=4)
+        low, high = evaluate.wilson_interval(0, 20)
+        self.assertEqual(low, 0.0)
+        self.assertAlmostEqual(high, 0.1611, places=4)
+        self.assertAlmostEqual(evaluate.wilson_interval(1, 1)[0], 1 / (1 + 1.959963984540054 ** 2), places=12)
+
+    def test_expert_succeeds_and_its_actions_replay(self):
+        out = self.out("expert")
+        self.assertEqual(evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", "expert", "--indices", "2",
+                                        "--out", out, "--save-actions"]), 0)
+        (row,) = episodes(out)
+        self.assertEqual((row["task"], row["index"], row["success"], row["failure"]), ("ALN", "2", "True", ""))
+        steps = int(row["steps"])
+        self.assertLessEqual(steps, 1500)
+        with open(os.path.join(out, "results.csv")) as f:
+            table = {(r["task"], r["category"]): r for r in csv.DictReader(f)}
+        self.assertEqual(float(table[("ALN", "all")]["acc"]), 100.0)
+        self.assertEqual(float(table[("ALN", "all")]["mean_steps"]), steps)
+        self.assertAlmostEqual(float(table[("ALN", "all")]["acc_low"]), 100 / (1 + 1.959963984540054 ** 2), places=2)
+        with open(os.path.join(out, "summary.json")) as f:
+            self.assertEqual(json.load(f)["success_rate"], 1.0)
+        with open(os.path.join(out, "results.md")) as f:
+            self.assertIn("| ALN | **all** | 1 | 100.0 |", f.read())
+        self.assertEqual(np.load(os.path.join(out, "actions", "ALN_clean_2.npy")).shape, (steps, 61))
+        replay = self.out("replay")
+        evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", "replay:" + out, "--indices", "2", "--out", replay])
+        (again,) = episodes(replay)
+        self.assertEqual((again["success"], again["steps"]), ("True", row["steps"]))
+
+    def test_failing_python_policies_fail_their_episodes_only(self):
+        for name, reason, detail in [("raising", "policy_error", "RuntimeError: model checkpoint missing"),
+                                     ("wrong_shape", "bad_action", "shape (4, 7)")]:
+            out = self.out(name)
+            code = evaluate.main(["--task", "COLL", "--setting", "clean", "--policy", "python:eval_policies:" + name,
+                                  "--indices", "0", "1", "--image-size", "32", "32", "--out", out])
+            self.assertEqual(code, 0)
+            rows = episodes(out)
+            self.assertEqual(len(rows), 2)
+            for r in rows:
+                self.assertEqual((r["success"], r["failure"], r["steps"]), ("False", reason, "0"))
+                self.assertIn(detail, r["detail"])
+
+    def test_action_chunks_run_chunk_steps_per_call(self):
+        eval_policies.calls["zeros_chunk"] = 0
+        out = self.out("chunks")
+        evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", "python:eval_policies:zeros_chunk", "--indices", "0",
+                       "--chunk-steps", "8", "--image-size", "32", "24", "--out", out])
+        (row,) = episodes(out)
+        self.assertEqual((row["failure"], row["steps"]), ("timeout", "1500"))
+        self.assertEqual(eval_policies.calls["zeros_chunk"], -(-1500 // 8))
+
+    def test_policy_server_on_loopback(self):
+        server = PolicyServer(chunk=5)
+        try:
+            out = self.out("ws")
+            evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", f"ws://127.0.0.1:{server.port}", "--indices", "0",
+                           "--chunk-steps", "5", "--image-size", "32", "24", "--out", out])
+        finally:
+            server.stop()
+        (row,) = episodes(out)
+        self.assertEqual((row["failure"], row["steps"]), ("timeout", "1500"))
+        self.assertEqual(len(server.requests), 300)
+        shape, dtype, prompt = server.requests[0]
+        self.assertEqual((shape, dtype), ((24, 32, 3), np.uint8))
+        self.assertTrue(prompt.endswith("."))
+
+    def test_slow_policy_server_times_out(self):
+        server = PolicyServer(chunk=5, delay=2.0)
+        try:
+            out = self.out("slow")
+            evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", f"ws://127.0.0.1:{server.port}", "--indices", "0",
+                           "--policy-timeout", "0.5", "--image-size", "32", "24", "--out", out])
+        finally:
+            server.stop()
+        (row,) = episodes(out)
+        self.assertEqual((row["success"], row["failure"], row["steps"]), ("False", "policy_timeout", "0"))
+
+    def test_no_server_is_a_failed_episode(self):
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        out = self.out("none")
+        evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", f"ws://127.0.0.1:{port}", "--indices", "0",
+                       "--image-size", "32", "24", "--out", out])
+        (row,) = episodes(out)
+        self.assertEqual(row["failure"], "policy_error")
+        self.assertIn("cannot connect", row["detail"])
+
+    def test_worker_processes_give_the_serial_result(self):
+        results = []
+        for jobs in ("1", "2"):
+            out = self.out("jobs" + jobs)
+            evaluate.main(["--task", "ARR", "--setting", "randomized", "--policy", "random", "--indices", "0", "1", "2",
+                           "--jobs", jobs, "--out", out])
+            results.append([{k: v for k, v in r.items() if k != "wall_s"} for r in episodes(out)])
+        self.assertEqual(results[0], results[1])
+
+    def test_bad_flags_exit_2(self):
+        for argv in (["--policy", "python:nomodule"], ["--policy", "grpc://x"], ["--jobs", "0"], ["--chunk-steps", "0"]):
+            with self.assertRaises(SystemExit) as e:
+                evaluate.main(argv + ["--out", self.out("bad")])
+            self.assertEqual(e.exception.code, 2)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,170 @@
+"""The `manisoft` module's task environments used as a Gymnasium user would: the spaces, the
+observation (image and instruction, privileged state on request), the expert finishing a fixed
+scene, bit-identical replays, a rendered state matching the environment's own image, and bad input
+refused with a clear exception that changes nothing. Run: PYTHONPATH=<build>/python python3 -m unittest."""
+import json
+import unittest
+
+import numpy as np
+
+import manisoft
+
+SMALL = {"width": 96, "height": 80}
+
+
+def run(env, actions):
+    for a in actions:
+        obs, *_ = env.step(a)
+    return obs
+
+
+class TaskEnvTest(unittest.TestCase):
+    def test_spaces_and_observation(self):
+        env = manisoft.make_env("COLL", "clean", seed=0, render=True, camera=SMALL, privileged=True)
+        space = env.action_space
+        n = env.n_elements
+        self.assertEqual(n, 20)
+        self.assertEqual(space["shape"], (3 * n + 1,))
+        high = space["high"]
+        # Element 0 is the clamped base (no torque); bend limits 150 N m, twist 75 N m; S in [0, 1].
+        np.testing.assert_array_equal(high[:3], [0, 0, 0])
+        np.testing.assert_array_equal(high[3:-1], np.tile([150.0, 150.0, 75.0], n - 1))
+        np.testing.assert_array_equal(space["low"][:-1], -high[:-1])
+        self.assertEqual((space["low"][-1], high[-1]), (0.0, 1.0))
+        obs, info = env.reset(options={"index": 3})
+        scene = json.loads(env.scene_json())
+        self.assertEqual(obs["instruction"], scene["instruction"])
+        self.assertEqual((info["task"], info["setting"], info["index"], info["steps"]), ("COLL", "clean", 3, 0))
+        for key, (shape, dtype) in env.observation_space.items():
+            if key == "instruction":
+                self.assertIsInstance(obs[key], str)
+                continue
+            value = np.asarray(obs[key])
+            expected = tuple(len(scene["objects"]) if s == -1 else s for s in shape)
+            self.assertEqual(value.shape, expected, key)
+            self.assertEqual(value.dtype, np.dtype(dtype), key)
+        self.assertEqual(obs["image"].shape, (80, 96, 3))
+        # The arm is clamped at its mount: node 0 at the scene's base position.
+        np.testing.assert_allclose(obs["rod_nodes"][0], scene["arm_mount"]["base_position"], atol=1e-9)
+        # Objects start where the scene puts them (asset frame -> world).
+        for i, o in enumerate(scene["objects"]):
+            np.testing.assert_allclose(obs["object_poses"][i][:3, 3], o["pose"]["position"], atol=2e-3)
+        # Not a blank frame: the table, arm and objects give many distinct colours.
+        self.assertGreater(len(np.unique(obs["image"].reshape(-1, 3), axis=0)), 50)
+
+    def test_expert_finishes_a_fixed_scene(self):
+        env = manisoft.make_env("COLL", "clean", seed=0)
+        obs, info = env.reset(options={"index": 3})
+        rewards = []
+        for _ in range(env.horizon):
+            obs, reward, terminated, truncated, info = env.step(env.expert_action())
+            rewards.append(reward)
+            if terminated or truncated:
+                break
+        self.assertTrue(info["success"], info)
+        self.assertTrue(terminated)
+        self.assertFalse(truncated)
+        self.assertIsNone(info["failure"])
+        self.assertLessEqual(info["steps"], 1500)
+        self.assertEqual(sum(rewards), 1.0)
+        self.assertEqual(rewards[-1], 1.0)
+        with self.assertRaisesRegex(RuntimeError, "episode is over"):
+            env.step(np.zeros(61))
+
+    def test_zero_torques_time_out_at_the_horizon(self):
+        env = manisoft.make_env("ALN", "clean", seed=0)
+        env.reset(options={"index": 0})
+        action = np.zeros(61)
+        for step in range(1, 1501):
+            _, reward, terminated, truncated, info = env.step(action)
+            if terminated or truncated:
+                break
+        self.assertEqual(step, 1500)
+        self.assertTrue(truncated)
+        self.assertFalse(terminated)
+        self.assertEqual(info["failure"], "timeout")
+
+    def test_same_seed_same_episode_and_actions_replay_bit_for_bit(self):
+        env = manisoft.make_env("ARR", "randomized", seed=4, privileged=True)
+        env.reset(options={"index": 1})
+        actions, states = [], []
+        for _ in range(80):
+            a = env.expert_action()
+            actions.append(a)
+            obs, *_ = env.step(a)
+            states.append(obs["rod_nodes"].copy())
+        other = manisoft.make_env("ARR", "randomized", seed=4, privileged=True)
+        other.reset(options={"index": 1})
+        for a, x in zip(actions, states):
+            obs, *_ = other.step(a)
+            self.assertTrue(np.array_equal(obs["rod_nodes"], x))
+        # the same scene through its JSON text
+        third = manisoft.make_env("ARR", "randomized", seed=99, privileged=True)
+        third.reset(options={"scene": env.scene_json()})
+        self.assertTrue(np.array_equal(run(third, actions)["rod_nodes"], states[-1]))
+
+    def test_renderer_draws_a_given_state_as_the_environment_does(self):
+        env = manisoft.make_env("STK", "randomized", seed=0, render=True, camera=SMALL, privileged=True)
+        env.reset(options={"index": 2})
+        obs = run(env, [env.expert_action() for _ in range(30)])
+        image = manisoft.Renderer().render(env.scene_json(), obs["rod_nodes"], obs["gripper_pose"], obs["gripper_width"],
+                                           obs["object_poses"], camera=SMALL)
+        self.assertTrue(np.array_equal(image, obs["image"]))
+        self.assertTrue(np.array_equal(env.render(), obs["image"]))
+
+    def test_instructions_seen_and_unseen(self):
+        env = manisoft.make_env("COLL", "randomized", seed=0)
+        scene = json.loads(manisoft.SceneSampler().sample("COLL", "randomized", 5, 0, "eval"))
+        for kind in ("seen", "unseen"):
+            self.assertTrue(scene["instructions_" + kind])  # randomized scenes have both kinds
+            obs, info = env.reset(options={"index": 5, "split": "eval", "instruction": kind, "instruction_index": 1})
+            self.assertEqual(info["instruction_kind"], kind)
+            lst = scene["instructions_" + kind]
+            self.assertEqual(obs["instruction"], lst[1 % len(lst)])
+        self.assertEqual(json.loads(env.scene_json())["split"], "eval")
+
+    def test_bad_input_is_refused_and_changes_nothing(self):
+        env = manisoft.make_env("COLL", "clean", seed=0, privileged=True)
+        with self.assertRaisesRegex(RuntimeError, "reset"):
+            env.step(np.zeros(61))
+        env.reset(options={"index": 0})
+        good = np.zeros(61)
+        good[3:-1] = 5.0
+        for bad, pattern in [(np.zeros(60), r"shape \(61,\)"), (np.zeros((20, 3)), r"shape \(61,\)"),
+                             (np.array(["a"] * 61), "dtype must be real"), (np.zeros(61, dtype=complex), "dtype must be real")]:
+            with self.assertRaisesRegex(ValueError, pattern):
+                env.step(bad)
+        nan = good.copy()
+        nan[7] = np.nan
+        with self.assertRaisesRegex(ValueError, r"entry 7 \(element 2, component d2\) is not finite"):
+            env.step(nan)
+        nan_s = good.copy()
+        nan_s[-1] = np.inf
+        with self.assertRaisesRegex(ValueError, r"\(S\) is not finite"):
+            env.step(nan_s)
+        obs, *_ = env.step(good)
+        fresh = manisoft.make_env("COLL", "clean", seed=0, privileged=True)
+        fresh.reset(options={"index": 0})
+        expected, *_ = fresh.step(good)
+        self.assertTrue(np.array_equal(obs["rod_nodes"], expected["rod_nodes"]))
+        with self.assertRaisesRegex(ValueError, "unknown option 'level'"):
+            env.reset(options={"level": 2})
+        with self.assertRaisesRegex(ValueError, "instruction"):
+            env.reset(options={"instruction": "paraphrased"})
+        with self.assertRaisesRegex(ValueError, "not valid JSON"):
+            env.reset(options={"scene": "{"})
+        with self.assertRaisesRegex(RuntimeError, "render=True"):
+            env.render()
+        with self.assertRaisesRegex(ValueError, "unknown environment 'PICK'"):
+            manisoft.make_env("PICK")
+        with self.assertRaisesRegex(ValueError, "setting"):
+            manisoft.make_env("COLL", "foggy")
+        with self.assertRaisesRegex(ValueError, "camera: unknown key 'zoom'"):
+            manisoft.make_env("COLL", camera={"zoom": 2})
+        env.close()
+        with self.assertRaisesRegex(RuntimeError, "closed"):
+            env.step(good)
+
+
+if __name__ == "__main__":
+    unittest.main()
