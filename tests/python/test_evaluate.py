@@ -129,15 +129,20 @@ class EvaluateTest(unittest.TestCase):
         self.assertEqual((row["failure"], row["steps"]), ("timeout", "1500"))
         self.assertEqual(eval_policies.calls["zeros_chunk"], -(-1500 // 8))
 
-    def test_policy_server_on_loopback(self):
-        server = PolicyServer(chunk=5)
+    def run_with_server(self, server, *flags):
+        """One ALN clean episode (eval index 0) against `server`, 32 x 24 images; its episodes.csv row."""
+        out = self.out(f"ws{server.port}")
         try:
-            out = self.out("ws")
             evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", f"ws://127.0.0.1:{server.port}", "--indices", "0",
-                           "--chunk-steps", "5", "--image-size", "32", "24", "--out", out])
+                           "--image-size", "32", "24", "--out", out, *flags])
         finally:
             server.stop()
         (row,) = episodes(out)
+        return row
+
+    def test_policy_server_on_loopback(self):
+        server = PolicyServer(chunk=5)
+        row = self.run_with_server(server, "--chunk-steps", "5")
         self.assertEqual((row["failure"], row["steps"]), ("timeout", "1500"))
         self.assertEqual(len(server.requests), 300)
         shape, dtype, prompt = server.requests[0]
@@ -145,14 +150,7 @@ class EvaluateTest(unittest.TestCase):
         self.assertTrue(prompt.endswith("."))
 
     def test_slow_policy_server_times_out(self):
-        server = PolicyServer(chunk=5, delay=2.0)
-        try:
-            out = self.out("slow")
-            evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", f"ws://127.0.0.1:{server.port}", "--indices", "0",
-                           "--policy-timeout", "0.5", "--image-size", "32", "24", "--out", out])
-        finally:
-            server.stop()
-        (row,) = episodes(out)
+        row = self.run_with_server(PolicyServer(chunk=5, delay=2.0), "--policy-timeout", "0.5")
         self.assertEqual((row["success"], row["failure"], row["steps"]), ("False", "policy_timeout", "0"))
 
     def test_no_server_is_a_failed_episode(self):

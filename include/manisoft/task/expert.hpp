@@ -70,6 +70,8 @@ struct ExpertConfig {
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
   int max_retries = 1;              ///< re-tries of a missed grasp
   double approach_distance = 0.06;  ///< m: the approach pose this far from the grasp, along the annotation's approach direction
+  int detours = 0;                  ///< detour points tried for a refused line (0-5)
+  bool ramp_fallback = true;        ///< a refused line may be replaced by a shape ramp
 };
 
 /// What the expert is doing.
@@ -106,7 +108,7 @@ class Expert {
   using Executor = TaskEnv::Executor;
 
   explicit Expert(const TaskEnv& env, ExpertConfig config = {})
-      : env_(&env), config_(config), executor_(env.home_executor()), planner_(env.home_executor()) {
+      : env_(&env), config_(config), executor_(env.home_executor()), planner_(env.home_executor()), planner_backup_(env.home_executor()), planner_detour_(env.home_executor()) {
     const int n = env.arm_model().rod.n_elements;
     observation_ = control::make_arm_observation<double>(n, env.config().observe_stride);
     events_.reserve(64);
@@ -150,13 +152,26 @@ class Expert {
   /// One move: the object, where it goes, and the end-effector waypoints. A leg is one or two
   /// straight lines: direct, or "via" (approach: level to above the approach pose first; carry:
   /// straight up by lift_height first, then level to above the place pose).
+  /// The lines of a leg, in order; a "ramp" line is the executor's shape ramp to the pose's cold
+  /// inverse statics solution instead of a straight line (the fallback of a refused line).
+  struct Leg {
+    std::array<Pose, 8> pose;
+    std::array<bool, 8> ramp{};
+    int count = 0;
+    void clear() { count = 0; }
+    void push(const Pose& p, bool r = false) { pose[static_cast<std::size_t>(count)] = p, ramp[static_cast<std::size_t>(count)] = r, ++count; }
+    void insert(int i, const Pose& p, bool r) {
+      for (int j = count; j > i; --j) pose[static_cast<std::size_t>(j)] = pose[static_cast<std::size_t>(j - 1)], ramp[static_cast<std::size_t>(j)] = ramp[static_cast<std::size_t>(j - 1)];
+      pose[static_cast<std::size_t>(i)] = p, ramp[static_cast<std::size_t>(i)] = r, ++count;
+    }
+    bool full() const { return count >= static_cast<int>(pose.size()); }
+  };
   struct Plan {
     int object = -1;
     Pose object_target;  ///< asset frame -> world at release
     Pose grasp, place;   ///< end-effector poses
     bool via_approach = false, via_carry = false;
-    std::array<Pose, 4> approach_leg, carry_leg;
-    int approach_count = 1, carry_count = 1;
+    Leg approach_leg, carry_leg;
   };
 
   /// Appends `to` to a leg, after an arc point when the straight line from `from` would pass
@@ -164,7 +179,7 @@ class Expert {
   /// annulus about its base, and a chord cuts towards its inner edge. The arc point: the farther
   /// end's distance from the base at the ends' mean bearing, the higher end's height, the
   /// orientations' midway.
-  void append_leg(std::array<Pose, 4>& leg, int& count, const Pose& from, const Pose& to) const {
+  void append_leg(Leg& leg, const Pose& from, const Pose& to) const {
     const Eigen::Vector2d base = env_->spec().arm_mount.base_position.head<2>();
     const Eigen::Vector2d a = from.translation.head<2>() - base, b = to.translation.head<2>() - base, ab = b - a;
     const double t = ab.squaredNorm() > 1e-12 ? std::clamp(-a.dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
@@ -174,9 +189,9 @@ class Expert {
       Pose via;
       via.translation << base + r * Eigen::Vector2d(std::cos(bearing), std::sin(bearing)), std::max(from.translation.z(), to.translation.z());
       via.rotation = Eigen::Quaterniond(from.rotation).slerp(0.5, Eigen::Quaterniond(to.rotation)).toRotationMatrix();
-      leg[static_cast<std::size_t>(count++)] = via;
+      leg.push(via);
     }
-    leg[static_cast<std::size_t>(count++)] = to;
+    leg.push(to);
   }
 
   /// The annotation's approach pose moved to approach_distance from its grasp (same direction).
@@ -189,30 +204,30 @@ class Expert {
 
   /// The approach leg from the end-effector pose `from` (the annotation's approach pose last).
   void set_approach_leg(Plan& p, const Pose& approach, const Pose& from) const {
-    p.approach_count = 0;
+    p.approach_leg.clear();
     Pose prev = from;
     if (p.via_approach) {
       Pose above = approach;
       above.translation.z() = std::max(approach.translation.z(), from.translation.z());
-      append_leg(p.approach_leg, p.approach_count, prev, above);
+      append_leg(p.approach_leg, prev, above);
       prev = above;
     }
-    append_leg(p.approach_leg, p.approach_count, prev, approach);
+    append_leg(p.approach_leg, prev, approach);
   }
   /// The carry leg from the grasp to carry_height above the place pose.
   void set_carry_leg(Plan& p) const {
     Pose above = p.place;
     above.translation.z() += config_.carry_height;
-    p.carry_count = 0;
+    p.carry_leg.clear();
     Pose prev = p.grasp;
     if (p.via_carry) {
       Pose lift = p.grasp;
       lift.translation.z() += config_.lift_height;
       above.translation.z() = std::max(above.translation.z(), lift.translation.z());
-      append_leg(p.carry_leg, p.carry_count, prev, lift);
+      append_leg(p.carry_leg, prev, lift);
       prev = lift;
     }
-    append_leg(p.carry_leg, p.carry_count, prev, above);
+    append_leg(p.carry_leg, prev, above);
   }
 
   int count_moves() const {
@@ -305,7 +320,6 @@ class Expert {
     const auto [object, target] = move_goal(k);
     const auto& a = asset_of(object);
     const Pose now = state_of(object).pose;
-    const double top = env_->spec().table.top_center.z();
     struct Candidate {
       double cost;
       Plan plan;
@@ -342,36 +356,117 @@ class Expert {
     }
     std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
     plan_refusal_ = candidates.empty() ? "the asset has no grasp annotation" : "";
-    for (const auto& c : candidates) {
+    for (auto& c : candidates) {
       planner_ = executor_;
       planner_.complete_path();
-      std::array<Pose, 10> seq;
-      std::array<const char*, 10> names{};
-      int n = 0;
-      for (int i = 0; i < c.plan.approach_count; ++i) names[n] = "approach", seq[n++] = c.plan.approach_leg[i];
-      names[n] = "grasp", seq[n++] = c.plan.grasp;
-      const int carry_from = n;
-      for (int i = 0; i < c.plan.carry_count; ++i) names[n] = "carry", seq[n++] = c.plan.carry_leg[i];
-      names[n] = "place", seq[n++] = c.plan.place;
-      bool ok = true;
-      for (int i = 0; i < n && ok; ++i) {
-        if (i == carry_from) planner_.set_payload(a.mass, c.plan.grasp.rotation.transpose() * (now.act(a.center_of_mass) - c.plan.grasp.translation));
-        const auto report = planner_.track_line(seq[i], 100);
-        planner_.complete_path();
-        if (!report.accepted) {
-          ok = false;
-          if (plan_refusal_.empty()) plan_refusal_ = std::string(names[i]) + ": " + report.reason;
-        } else if (planner_.statics().desired_state().positions.col(2).minCoeff() < top + config_.table_clearance) {
-          ok = false;
-          if (plan_refusal_.empty()) plan_refusal_ = std::string(names[i]) + ": the arm would touch the table";
-        }
+      const char* why = "";
+      const char* where = "";
+      bool ok = check_leg(c.plan.approach_leg, why);
+      if (!ok) where = "approach";
+      if (ok && !(ok = check_line(c.plan.grasp, why))) where = "grasp";
+      if (ok) {
+        planner_.set_payload(a.mass, c.plan.grasp.rotation.transpose() * (now.act(a.center_of_mass) - c.plan.grasp.translation));
+        if (!(ok = check_leg(c.plan.carry_leg, why))) where = "carry";
       }
+      if (ok && !(ok = check_line(c.plan.place, why))) where = "place";
+#ifdef MANISOFT_EXPERT_TRACE
+      if (getenv("PLANTRACE")) {
+        std::fprintf(stderr, "    [cand] cost %.3f via %d%d ok %d %s %s grasp (%.3f %.3f %.3f) place (%.3f %.3f %.3f):", c.cost, int(c.plan.via_approach), int(c.plan.via_carry), int(ok), where, why,
+          c.plan.grasp.translation.x(), c.plan.grasp.translation.y(), c.plan.grasp.translation.z(), c.plan.place.translation.x(), c.plan.place.translation.y(), c.plan.place.translation.z());
+        for (int i = 0; i < c.plan.approach_leg.count; ++i) std::fprintf(stderr, " a%s(%.3f %.3f %.3f)", c.plan.approach_leg.ramp[i] ? "R" : "", c.plan.approach_leg.pose[i].translation.x(), c.plan.approach_leg.pose[i].translation.y(), c.plan.approach_leg.pose[i].translation.z());
+        for (int i = 0; i < c.plan.carry_leg.count; ++i) std::fprintf(stderr, " c%s(%.3f %.3f %.3f)", c.plan.carry_leg.ramp[i] ? "R" : "", c.plan.carry_leg.pose[i].translation.x(), c.plan.carry_leg.pose[i].translation.y(), c.plan.carry_leg.pose[i].translation.z());
+        std::fprintf(stderr, "\n");
+      }
+#endif
       if (ok) {
         plan_ = c.plan;
         return true;
       }
+      if (plan_refusal_.empty()) plan_refusal_ = std::string(where) + ": " + why;
     }
     return false;
+  }
+
+  /// Tracks one line to `to` on planner_ (from its shape target) and jumps to its end; false
+  /// (the planner as before, `why` set) when the executor refuses it or its end shape comes
+  /// within table_clearance of the table top.
+  bool check_line(const Pose& to, const char*& why) {
+    planner_backup_ = planner_;
+    const auto report = planner_.track_line(to, 100);
+    planner_.complete_path();
+    if (!report.accepted) {
+      why = report.reason;
+      planner_ = planner_backup_;
+      return false;
+    }
+    if (planner_.statics().desired_state().positions.col(2).minCoeff() < env_->spec().table.top_center.z() + config_.table_clearance) {
+      why = "the arm would touch the table";
+      planner_ = planner_backup_;
+      return false;
+    }
+    return true;
+  }
+
+  /// Checks a ramp to `to` on planner_ (the cold inverse statics solution within the limits and
+  /// clear of the table) and jumps to its end; false (the planner as before) otherwise.
+  bool check_ramp(const Pose& to) {
+    planner_backup_ = planner_;
+    const auto r = planner_.set_target(to);
+    planner_.complete_path();
+    if (r.within_limits && planner_.statics().desired_state().positions.col(2).minCoeff() >= env_->spec().table.top_center.z() + config_.table_clearance) return true;
+    planner_ = planner_backup_;
+    return false;
+  }
+
+  /// Checks a leg's lines on planner_; a refused line is retried after a detour point inserted
+  /// before it (see detour()), then as a ramp. False when a line has no acceptable detour.
+  bool check_leg(Leg& leg, const char*& why) {
+    for (int i = 0; i < leg.count; ++i) {
+      const Pose from = planner_.statics().desired_tip_pose();
+      const Pose to = leg.pose[static_cast<std::size_t>(i)];
+      if (leg.ramp[static_cast<std::size_t>(i)] ? check_ramp(to) : check_line(to, why)) continue;
+      bool repaired = false;
+      for (int d = 0; d < config_.detours && !repaired && !leg.full(); ++d) {
+        const Pose via = detour(from, to, d);
+        const char* ignored = "";
+        planner_detour_ = planner_;
+        if (check_line(via, ignored) && check_line(to, ignored)) {
+          leg.insert(i, via, false);
+          ++i;  // `to` is checked already
+          repaired = true;
+#ifdef MANISOFT_EXPERT_TRACE
+          if (getenv("PLANTRACE")) std::fprintf(stderr, "      detour %d repaired (%s)\n", d, why);
+#endif
+        } else {
+          planner_ = planner_detour_;
+        }
+      }
+      if (!repaired && config_.ramp_fallback && check_ramp(to)) {
+        leg.ramp[static_cast<std::size_t>(i)] = true;
+        repaired = true;
+#ifdef MANISOFT_EXPERT_TRACE
+        if (getenv("PLANTRACE")) std::fprintf(stderr, "      ramp repaired (%s)\n", why);
+#endif
+      }
+      if (!repaired) return false;
+    }
+    return true;
+  }
+
+  /// Detour points of a refused line from -> to: turn first, move first, the midpoint raised
+  /// or lowered (half the turn there).
+  Pose detour(const Pose& from, const Pose& to, int kind) const {
+    Pose via;
+    via.translation = 0.5 * (from.translation + to.translation);
+    via.rotation = Eigen::Quaterniond(from.rotation).slerp(0.5, Eigen::Quaterniond(to.rotation)).toRotationMatrix();
+    switch (kind) {
+      case 0: via.translation = from.translation, via.rotation = to.rotation; break;
+      case 1: via.translation = to.translation, via.rotation = from.rotation; break;
+      case 2: via.translation.z() += 0.08; break;
+      case 3: via.translation.z() -= 0.05; break;
+      default: via.translation.z() += 0.16; break;
+    }
+    return via;
   }
 
   void begin_move() {
@@ -387,7 +482,7 @@ class Expert {
     }
     leg_ = 0;
     enter(ExpertPhase::approach);
-    start_path(plan_.approach_leg[0]);
+    start_leg(plan_.approach_leg, 0);
   }
 
   void enter(ExpertPhase p) {
@@ -415,12 +510,35 @@ class Expert {
     const double node = loaded ? config_.carry_node_speed : config_.max_node_speed;
     const int steps = std::max(config_.min_segment_steps, static_cast<int>(std::ceil(1.875 * distance / peak / control_dt)));
     const auto report = executor_.track_line(goal, steps, node * control_dt);
+#ifdef MANISOFT_EXPERT_TRACE
+    std::fprintf(stderr, "  [path] step %ld phase %d leg %d dist %.3f to (%.3f %.3f %.3f) steps %d -> %d ok %d %s\n", steps_, int(phase_), leg_, distance,
+                 goal.translation.x(), goal.translation.y(), goal.translation.z(), steps, report.steps, int(report.accepted), report.reason);
+#endif
     if (!report.accepted) {
       if (required) give_up(report.reason);
       return false;
     }
     target_ = goal;
     return true;
+  }
+
+  /// Starts line i of a leg: a path, or a shape ramp (the executor's set_target).
+  void start_leg(const Leg& leg, int i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (!leg.ramp[k]) {
+      start_path(leg.pose[k]);
+      return;
+    }
+    const auto r = executor_.set_target(leg.pose[k]);
+#ifdef MANISOFT_EXPERT_TRACE
+    std::fprintf(stderr, "  [ramp] step %ld phase %d leg %d to (%.3f %.3f %.3f) steps %d ok %d\n", steps_, int(phase_), leg_,
+                 leg.pose[k].translation.x(), leg.pose[k].translation.y(), leg.pose[k].translation.z(), executor_.ramp_length(), int(r.within_limits));
+#endif
+    if (!r.within_limits) {
+      give_up("a ramp target has no inverse statics solution within the actuation limits");
+      return;
+    }
+    target_ = leg.pose[k];
   }
 
   /// Whether something under the held object carries it (see the lower phase).
@@ -452,8 +570,8 @@ class Expert {
     switch (phase_) {
       case ExpertPhase::approach:
         if (done && error < config_.start_error) {
-          if (++leg_ < plan_.approach_count) {
-            start_path(plan_.approach_leg[static_cast<std::size_t>(leg_)]);
+          if (++leg_ < plan_.approach_leg.count) {
+            start_leg(plan_.approach_leg, leg_);
           } else {
             enter(ExpertPhase::descend);
             start_path(plan_.grasp);
@@ -484,9 +602,17 @@ class Expert {
         executor_.set_payload(a.mass, ee.rotation.transpose() * (object.act(a.center_of_mass) - ee.translation));
         plan_.place = plan_.object_target * object.inverse() * ee;
         set_carry_leg(plan_);
+        {
+          // the corrected carry, checked (and repaired with detours) from here
+          Plan checked = plan_;
+          planner_ = executor_;
+          planner_.complete_path();
+          const char* why = "";
+          if (check_leg(checked.carry_leg, why) && check_line(checked.place, why)) plan_ = checked;
+        }
         leg_ = 0;
         enter(ExpertPhase::carry);
-        start_path(plan_.carry_leg[0]);
+        start_leg(plan_.carry_leg, 0);
         break;
       }
       case ExpertPhase::carry:
@@ -495,8 +621,8 @@ class Expert {
           break;
         }
         if (done && error < config_.start_error) {
-          if (++leg_ < plan_.carry_count) {
-            start_path(plan_.carry_leg[static_cast<std::size_t>(leg_)]);
+          if (++leg_ < plan_.carry_leg.count) {
+            start_leg(plan_.carry_leg, leg_);
           } else {
             enter(ExpertPhase::lower);
             start_path(plan_.place);
@@ -540,7 +666,7 @@ class Expert {
 
   const TaskEnv* env_;
   ExpertConfig config_;
-  Executor executor_, planner_;
+  Executor executor_, planner_, planner_backup_, planner_detour_;
   control::Observation<double> observation_;
   Pose target_;
   Plan plan_;
