@@ -119,7 +119,9 @@ class File {
       const std::size_t end = path.find('/', at);
       const std::string prefix = path.substr(0, end);
       if (H5Lexists(id(), prefix.c_str(), H5P_DEFAULT) <= 0) {
-        Handle g(H5Gcreate2(id(), prefix.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+        Handle untimed(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);  // no modification times: same content, same bytes
+        H5Pset_obj_track_times(untimed.get(), 0);
+        Handle g(H5Gcreate2(id(), prefix.c_str(), H5P_DEFAULT, untimed.get(), H5P_DEFAULT), H5Gclose);
         if (!g.valid()) fail_at(name_, prefix, "cannot create the group");
       }
       if (end == std::string::npos) break;
@@ -146,6 +148,7 @@ class File {
     ScopedSilence silence;
     Handle space(H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr), H5Sclose);
     Handle properties(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+    H5Pset_obj_track_times(properties.get(), 0);  // no modification times: same content, same bytes
     bool empty = false;
     for (hsize_t s : shape) empty = empty || s == 0;
     if (compression > 0 && !empty) {
@@ -293,7 +296,9 @@ class File {
     H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
     const hsize_t n = values.size();
     Handle space(H5Screate_simple(1, &n, nullptr), H5Sclose);
-    Handle data(H5Dcreate2(id(), path.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
+    Handle untimed(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+    H5Pset_obj_track_times(untimed.get(), 0);
+    Handle data(H5Dcreate2(id(), path.c_str(), type.get(), space.get(), H5P_DEFAULT, untimed.get(), H5P_DEFAULT), H5Dclose);
     if (!data.valid()) fail_at(name_, path, "cannot create the string dataset");
     if (n > 0 && H5Dwrite(data.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, packed.data()) < 0)
       fail_at(name_, path, "writing the string dataset failed");

@@ -1,0 +1,283 @@
+// generate_dataset: the expert dataset (issue 15; paper section 3.5) as robomimic-layout HDF5 files
+// (include/manisoft/dataset/: one file an episode under DIR/episodes/, the index DIR/dataset.hdf5).
+//
+//   generate_dataset --tasks COLL,ALN,STK,ARR --clean N --randomized M --seed S --out DIR
+//                    [--shard i/n] [--resume] [--images none|every:K] [--image-size W H] [--jobs J]
+//                    [--max-draws A] [--index-only]
+//
+// Episode k (0 <= k < N + M) is a pure function of (seed, k): clean for k < N, randomized after;
+// within a setting, the tasks take turns (j-th episode of the setting: task j mod T, its
+// (j div T)-th of that task). Its scene is train-split scene index (j div T) * A + a for draw
+// a = 0, 1, ...: the first draw whose expert episode succeeds is kept (the paper's quality check:
+// only successful expert episodes), the others are redrawn and counted with their reason. So the
+// same dataset comes out as one shard or as n shards (--shard i/n takes k = i, i + n, ...), with
+// any --jobs: file for file, bit for bit.
+// Atomic and resumable: an episode is written under a temporary name and renamed when complete;
+// --resume skips complete episodes (a killed run loses only the episodes in flight). When every
+// episode of the dataset is there, the index is written (--index-only: only that, the merge step
+// after a sharded run; it names the first missing episode). Progress on stderr: a bar on a
+// terminal, plain lines otherwise. Exit 0 on success, 1 on an error, 2 on bad flags.
+#include <CLI/CLI.hpp>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../render/spec_render_scene.hpp"
+#include "manisoft/dataset/dataset_index.hpp"
+#include "manisoft/dataset/expert_recording.hpp"
+#include "manisoft/render/gl_renderer.hpp"
+#include "manisoft/scene/scene_sampler.hpp"
+#include "manisoft/task/expert.hpp"
+
+namespace fs = std::filesystem;
+namespace ms = manisoft;
+
+namespace {
+
+struct Plan {
+  std::vector<ms::scene::Task> tasks;
+  long clean = 0, randomized = 0;
+  std::uint64_t seed = 0;
+  int max_draws = 100;
+  int image_every = 0;  // 0: no images
+  int image_width = 128, image_height = 128;
+
+  long total() const { return clean + randomized; }
+  /// Task, setting and the first scene index of episode k.
+  ms::scene::SampleRequest request(long k) const {
+    const bool is_clean = k < clean;
+    const long j = is_clean ? k : k - clean;
+    const long t = static_cast<long>(tasks.size());
+    ms::scene::SampleRequest q;
+    q.task = tasks[static_cast<std::size_t>(j % t)];
+    q.setting = is_clean ? ms::scene::Setting::clean : ms::scene::Setting::randomized;
+    q.split = ms::scene::Split::train;
+    q.index = static_cast<std::uint64_t>(j / t) * static_cast<std::uint64_t>(max_draws);
+    q.seed = seed;
+    return q;
+  }
+  std::string env_args() const {
+    nlohmann::json j;
+    j["env_name"] = "ManiSoft";
+    j["type"] = "manisoft";
+    std::vector<std::string> names;
+    for (auto t : tasks) names.emplace_back(ms::scene::to_string(t));
+    j["env_kwargs"] = {{"tasks", names},       {"clean", clean},  {"randomized", randomized}, {"seed", seed},
+                       {"max_draws", max_draws}, {"horizon", 1500}, {"control_dt", 7 * 2e-4},    {"image_every", image_every},
+                       {"image_width", image_width}, {"image_height", image_height}};
+    return j.dump();
+  }
+};
+
+/// One worker: its own sampler, environment, expert (and renderer when images are asked for).
+class Worker {
+ public:
+  explicit Worker(const Plan& plan) : plan_(plan), env_(sampler_.library()), expert_(env_) {}
+
+  /// The kept episode k, and the reasons of the draws redrawn before it.
+  ms::dataset::Episode make(long k, std::map<std::string, long>& redraw_reasons) {
+    ms::scene::SampleRequest q = plan_.request(k);
+    const std::uint64_t first = q.index;
+    for (int a = 0; a < plan_.max_draws; ++a) {
+      q.index = first + static_cast<std::uint64_t>(a);
+      const ms::scene::SceneSpec spec = sampler_.sample(q);
+      env_.reset(spec);
+      expert_.reset();
+      ms::dataset::EpisodeRecorder recorder(env_);
+      ms::dataset::ImageSequence images;
+      ms::task::TaskEnv::Array3 torques;
+      int s = 0;
+      long step = 0;
+      if (plan_.image_every > 0) begin_images(spec, images);
+      while (!env_.done()) {
+        expert_.act(torques, s);
+        if (plan_.image_every > 0 && step % plan_.image_every == 0) add_image(images, step);
+        recorder.step(torques, s);
+        env_.step(torques, s);
+        ++step;
+      }
+      if (env_.info().success) {
+        ms::dataset::Episode e = recorder.finish(k, plan_.seed, a);
+        if (plan_.image_every > 0) e.images["agentview_image"] = std::move(images);
+        return e;
+      }
+      const std::string why = expert_.failure()[0] ? "expert: " + std::string(expert_.failure()) : std::string(ms::task::to_string(env_.info().failure));
+      ++redraw_reasons[std::string(ms::scene::to_string(q.task)) + " " + why.substr(0, 60)];
+    }
+    ms::detail::fail("episode ", k, ": no successful expert episode in ", plan_.max_draws, " draws (", ms::scene::to_string(q.task), " ",
+                     ms::scene::to_string(q.setting), ", scene indices ", first, "..", first + plan_.max_draws - 1, "): raise --max-draws");
+  }
+
+ private:
+  void begin_images(const ms::scene::SceneSpec& spec, ms::dataset::ImageSequence& images) {
+    if (!gl_) {
+      ms::render::GlRendererOptions o;
+      o.read_depth = false;
+      o.read_mask = false;
+      gl_ = std::make_unique<ms::render::GlRenderer>(o);
+    }
+    scene_ = ms::render::spec::make_spec_scene(spec, sampler_.library());
+    ms::render::Camera camera = spec.cameras.front();
+    camera.width = plan_.image_width;
+    camera.height = plan_.image_height;
+    scene_.scene.cameras = {camera};
+    gl_->set_scene(scene_.scene);
+    images = {};
+    images.width = plan_.image_width;
+    images.height = plan_.image_height;
+  }
+
+  void add_image(ms::dataset::ImageSequence& images, long step) {
+    const auto& w = env_.world();
+    ms::render::FrameState frame = scene_.frame;
+    frame.rod.nodes = w.rod().state().positions;
+    frame.rod.directors.resize(0, 9);
+    const ms::math::Pose<double> gripper{w.rigid().orientation(w.gripper_body()).toRotationMatrix(), w.rigid().position(w.gripper_body())};
+    ms::render::tabletop::set_gripper(scene_, frame, gripper, w.gripper().finger_width());
+    const auto& objects = env_.bodies().objects;
+    for (std::size_t i = 0; i < scene_.scene.instances.size(); ++i) {
+      const std::string& n = scene_.scene.instances[i].name;
+      if (n.rfind("object", 0) != 0) continue;
+      const std::size_t k = std::stoul(n.substr(6, n.find(' ') - 6));
+      frame.instance_poses[i] = {w.rigid().orientation(objects[k]).toRotationMatrix(), w.rigid().position(objects[k])};
+    }
+    gl_->render_into(frame, out_);
+    images.pixels.insert(images.pixels.end(), out_.rgb.begin(), out_.rgb.end());
+    images.steps.push_back(step);
+    ++images.frames;
+  }
+
+  const Plan& plan_;
+  ms::scene::SceneSampler sampler_;
+  ms::task::TaskEnv env_;
+  ms::task::Expert expert_;
+  std::unique_ptr<ms::render::GlRenderer> gl_;
+  ms::render::tabletop::TabletopScene scene_;
+  ms::render::RenderOutput out_;
+};
+
+std::vector<ms::scene::Task> parse_tasks(const std::string& list) {
+  std::vector<ms::scene::Task> out;
+  std::stringstream in(list);
+  std::string name;
+  while (std::getline(in, name, ',')) out.push_back(ms::scene::parse_task(name));
+  if (out.empty()) ms::detail::fail("--tasks: no task given");
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Generate the ManiSoft expert dataset (robomimic-layout HDF5)"};
+  std::string tasks = "COLL,ALN,STK,ARR", out, shard = "0/1", images = "none";
+  Plan plan;
+  int jobs = 1;
+  bool resume = false, index_only = false;
+  std::vector<int> image_size{128, 128};
+  app.add_option("--tasks", tasks, "comma-separated tasks (COLL, ALN, STK, ARR)");
+  app.add_option("--clean", plan.clean, "clean-scene episodes in all")->check(CLI::NonNegativeNumber);
+  app.add_option("--randomized", plan.randomized, "randomized-scene episodes in all")->check(CLI::NonNegativeNumber);
+  app.add_option("--seed", plan.seed, "dataset seed");
+  app.add_option("--out", out, "dataset folder")->required();
+  app.add_option("--shard", shard, "i/n: this process makes the episodes k with k mod n = i");
+  app.add_flag("--resume", resume, "skip episodes whose files are complete");
+  app.add_option("--images", images, "none, or every:K (a camera image every K control steps)");
+  app.add_option("--image-size", image_size, "W H of the images")->expected(2)->check(CLI::PositiveNumber);
+  app.add_option("--jobs", jobs, "worker threads")->check(CLI::Range(1, 256));
+  app.add_option("--max-draws", plan.max_draws, "scene draws per episode before giving up")->check(CLI::Range(1, 100000));
+  app.add_flag("--index-only", index_only, "only write the index (after every shard is done)");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    plan.tasks = parse_tasks(tasks);
+    long shard_i = 0, shard_n = 1;
+    if (std::sscanf(shard.c_str(), "%ld/%ld", &shard_i, &shard_n) != 2 || shard_n < 1 || shard_i < 0 || shard_i >= shard_n)
+      ms::detail::fail("--shard '", shard, "': expected i/n with 0 <= i < n");
+    if (images != "none") {
+      if (images.rfind("every:", 0) != 0 || std::sscanf(images.c_str() + 6, "%d", &plan.image_every) != 1 || plan.image_every < 1)
+        ms::detail::fail("--images '", images, "': expected none or every:K with K >= 1");
+    }
+    plan.image_width = image_size[0];
+    plan.image_height = image_size[1];
+    if (plan.total() < 1) ms::detail::fail("--clean + --randomized must be at least 1");
+    const fs::path dir = out;
+    fs::create_directories(ms::dataset::episode_folder(dir));
+    if (!index_only) {
+      std::vector<long> todo;
+      for (long k = shard_i; k < plan.total(); k += shard_n) {
+        const fs::path f = ms::dataset::episode_file(dir, k);
+        if (resume && fs::exists(f)) continue;
+        if (!resume && fs::exists(f)) ms::detail::fail(f.string(), " exists: use --resume to continue a run, or another --out");
+        todo.push_back(k);
+      }
+      const bool tty = isatty(fileno(stderr));
+      std::fprintf(stderr, "generate_dataset: %zu episodes to make (shard %ld/%ld of %ld), %d job(s)\n", todo.size(), shard_i, shard_n,
+                   plan.total(), jobs);
+      std::atomic<std::size_t> next{0};
+      std::mutex mutex;  // HDF5 writes, the report, progress
+      std::map<std::string, long> reasons;
+      long done = 0, redraws = 0;
+      std::string error;
+      const auto t0 = std::chrono::steady_clock::now();
+      auto work = [&] {
+        try {
+          Worker worker(plan);
+          for (std::size_t i; (i = next++) < todo.size();) {
+            std::map<std::string, long> local;
+            const ms::dataset::Episode e = worker.make(todo[i], local);
+            std::lock_guard lock(mutex);
+            if (!error.empty()) return;
+            ms::dataset::write_episode(ms::dataset::episode_file(dir, todo[i]), e);
+            for (const auto& [r, c] : local) reasons[r] += c, redraws += c;
+            ++done;
+            const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            const double rate = done / s;
+            const double left = (static_cast<double>(todo.size()) - done) / rate;
+            if (tty) {
+              const int width = 30, filled = static_cast<int>(width * done / static_cast<long>(todo.size()));
+              std::fprintf(stderr, "\r[%s%s] %ld/%zu episodes, %ld redrawn, %.2f episodes/s, %.0f s left   ", std::string(filled, '#').c_str(),
+                           std::string(width - filled, '.').c_str(), done, todo.size(), redraws, rate, left);
+            } else {
+              std::fprintf(stderr, "episode %ld: %s %s, %ld steps, %d redrawn; %ld/%zu done, %.2f episodes/s, %.0f s left\n", todo[i],
+                           e.text.at("task").c_str(), e.text.at("setting").c_str(), e.steps(), static_cast<int>(e.numbers.at("redraws")), done,
+                           todo.size(), rate, left);
+            }
+          }
+        } catch (const std::exception& ex) {
+          std::lock_guard lock(mutex);
+          if (error.empty()) error = ex.what();
+          next = todo.size();
+        }
+      };
+      std::vector<std::thread> threads;
+      for (int j = 1; j < jobs; ++j) threads.emplace_back(work);
+      work();
+      for (auto& t : threads) t.join();
+      if (tty) std::fprintf(stderr, "\n");
+      if (!error.empty()) ms::detail::fail(error);
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::printf("generate_dataset: %ld episodes written in %.1f s (%.2f episodes/s); %ld failed expert draws redrawn\n", done, s, done / s, redraws);
+      for (const auto& [r, c] : reasons) std::printf("  redrawn %5ld x  %s\n", c, r.c_str());
+    }
+    const auto complete = ms::dataset::complete_episodes(dir);
+    if (static_cast<long>(complete.size()) == plan.total() || index_only) {
+      ms::dataset::write_index(dir, plan.env_args(), plan.total());
+      std::printf("generate_dataset: index %s over %ld episodes\n", ms::dataset::index_file(dir).string().c_str(), plan.total());
+    } else {
+      std::printf("generate_dataset: %zu of %ld episodes complete; the index is written once all are (or run --index-only after the shards)\n",
+                  complete.size(), plan.total());
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "generate_dataset: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
