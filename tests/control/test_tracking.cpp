@@ -102,6 +102,29 @@ TEST_CASE("a path the arm cannot hold is refused and leaves the executor as it w
   CHECK_THROWS_WITH(executor.track_line(start, -1), Catch::Contains("-1"));
 }
 
+TEST_CASE("path timings: quintic by default, cruise profiles monotone from 0 to 1 at the stated peak speed", "[executor][tracking]") {
+  using Executor = control::ModelExecutor<double>;
+  for (double x = 0; x <= 1.0; x += 0.125) CHECK(Executor::path_timing(x, 0.0) == Approx(x * x * x * (10 - 15 * x + 6 * x * x)));
+  for (const double cruise : {0.2, 0.5, 0.8}) {
+    CAPTURE(cruise);
+    CHECK(Executor::path_timing(0.0, cruise) == 0.0);
+    CHECK(Executor::path_timing(1.0, cruise) == Approx(1.0));
+    CHECK(Executor::path_timing(0.5, cruise) == Approx(0.5));
+    constexpr int n = 2000;
+    double previous = 0, peak = 0;
+    for (int i = 1; i <= n; ++i) {
+      const double s = Executor::path_timing(double(i) / n, cruise);
+      CHECK(s >= previous);
+      peak = std::max(peak, (s - previous) * n);
+      previous = s;
+      CHECK(Executor::path_timing(1.0 - double(i) / n, cruise) == Approx(1.0 - s).margin(1e-12));
+    }
+    CHECK(peak == Approx(2.0 / (1.0 + cruise)).epsilon(1e-3));
+  }
+  Executor executor(tabletop_model(), {150, 75});
+  CHECK_THROWS_WITH(executor.track_line(executor.statics().desired_tip_pose(), 10, 1.0, 1.0), Catch::Contains("cruise"));
+}
+
 TEST_CASE("the tracker follows a moving target within a bound and converges at its end", "[executor][tracking]") {
   Env env({}, manisoft::rod::damping::AnalyticalLinear<double>(0.1));
   env.reset(1);

@@ -245,11 +245,18 @@ class ModelExecutor {
   /// `max_node_step` (m per control step; infinity: no bound) bounds the planned speed of every
   /// node: the knot shapes' largest node displacement over each knot interval, divided by the
   /// interval's control steps. A path planned faster is slowed (its steps stretched, reported in
-  /// report.steps); the quintic timing is kept.
-  PathReport<Scalar> track_line(const Pose& goal, int steps, Scalar max_node_step = std::numeric_limits<Scalar>::infinity()) {
+  /// report.steps); the timing's shape is kept.
+  ///
+  /// `cruise` in [0, 1) picks the timing: 0 quintic (minimum jerk, peak speed 1.875 x the mean);
+  /// above 0 a constant speed over that fraction of the steps, reached and left along cubic
+  /// smoothstep speed ramps over the rest, half at each end (peak speed 2 / (1 + cruise) x the
+  /// mean, acceleration continuous and zero at both ends): path_timing().
+  PathReport<Scalar> track_line(const Pose& goal, int steps, Scalar max_node_step = std::numeric_limits<Scalar>::infinity(), Scalar cruise = Scalar(0)) {
     math::require_valid_pose(goal, "executor path goal");
     if (steps < 0) manisoft::detail::fail("executor: track_line steps = ", steps, " must be >= 0");
     if (!(max_node_step > Scalar(0))) manisoft::detail::fail("executor: track_line max_node_step = ", max_node_step, " must be > 0");
+    if (!(cruise >= Scalar(0) && cruise < Scalar(1))) manisoft::detail::fail("executor: track_line cruise = ", cruise, " must be in [0, 1)");
+    cruise_ = cruise;
     PathReport<Scalar> report;
     report.steps = steps;
     const Coefficients c0 = statics_.coefficients();
@@ -638,12 +645,29 @@ class ModelExecutor {
 
   static Scalar quintic(Scalar x) { return x * x * x * (Scalar(10) + x * (Scalar(-15) + Scalar(6) * x)); }
 
+ public:
+  /// Path parameter (0..1) at time fraction x of a path with cruise fraction `cruise` (track_line):
+  /// quintic for 0; else speed V = 1 / (1 - a), a = (1 - cruise) / 2, reached over [0, a] along
+  /// V smoothstep(x / a) and left symmetrically over [1 - a, 1].
+  static Scalar path_timing(Scalar x, Scalar cruise) {
+    if (!(cruise > Scalar(0))) return quintic(x);
+    const Scalar a = Scalar(0.5) * (Scalar(1) - cruise), v = Scalar(1) / (Scalar(1) - a);
+    const auto ramp = [&](Scalar t) { return v * a * t * t * t * (Scalar(1) - Scalar(0.5) * t); };  // V a (t^3 - t^4 / 2)
+    if (x <= Scalar(0)) return Scalar(0);
+    if (x >= Scalar(1)) return Scalar(1);
+    if (x < a) return ramp(x / a);
+    if (x > Scalar(1) - a) return Scalar(1) - ramp((Scalar(1) - x) / a);
+    return Scalar(0.5) * v * a + v * (x - a);
+  }
+
+ private:
+
   /// Plans the knots of time fraction (u0, u1] of the current path (the knot at u0 is the last
   /// one in knots_); subdivides when the knot fails to converge within the limits or its blend
   /// fails the continuity check. Returns false when the path must be refused.
   bool plan_interval(Scalar u0, Scalar u1, Scalar steps, int depth, Vector3& tip_previous, PathReport<Scalar>& report) {
     const Coefficients from = knots_.back().c;
-    const Pose pose = path_pose(quintic(u1));
+    const Pose pose = path_pose(path_timing(u1, cruise_));
     // The smallest shape change that meets the knot (continuity); the full solver only if that fails.
     rod::InverseStaticsResult<Scalar> r = statics_.solve_near(pose, from);
     if (!r.within_limits) r = statics_.solve_from(pose, from);
@@ -746,6 +770,7 @@ class ModelExecutor {
   long path_steps_ = 0;
   Pose path_start_, path_goal_;
   Vector3 path_rotation_ = Vector3::Zero();
+  Scalar cruise_ = 0;  ///< the current path's cruise fraction (track_line)
   PathReport<Scalar> last_path_;
   Array3 desired_velocity_, previous_desired_;
   Coefficients outer_from_ = Coefficients::Zero(), outer_to_ = Coefficients::Zero();

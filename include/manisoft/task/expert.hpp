@@ -18,9 +18,10 @@
 // turn least from the home pose, whose whole sequence the executor accepts (continuous shapes
 // within the actuation limits, the payload included) and whose waypoint shapes keep every rod
 // node table_clearance above the table top.
-// Waypoints of a move (the end-effector frame; straight lines with quintic timing,
-// ModelExecutor::track_line): approach (along the annotation's approach direction,
-// approach_distance from the grasp; "via": first level to above it), grasp, close once settled
+// Waypoints of a move (the end-effector frame; straight lines with quintic timing, or a cruise
+// at constant speed over path_cruise of the line: ModelExecutor::track_line): approach (along
+// the annotation's approach direction, approach_distance from the grasp; "via": first level to
+// above it), grasp, close once settled
 // (the arm's tip slower than settle_speed), carry (above the place pose, diagonal from the grasp;
 // "via": first straight up by lift_height), place (corrected for where the object sits in the
 // hand, measured when it is held), open once settled or as soon as the support carries the
@@ -28,7 +29,14 @@
 // leg whose straight line would pass towards the inner edge of the arm's reach (arc_inset nearer
 // its base than its farther end) goes round an arc point about the base instead. A missed grasp
 // re-opens and retries the move from its approach (max_retries).
-// Deterministic; allocation only when a move is planned (path set-ups copy the executor).
+// Refused lines: the candidates are first checked with straight lines only; when none passes,
+// again with each refused approach or carry line replaced by the executor's shape ramp to the
+// pose's cold inverse statics solution (ModelExecutor::set_target; ramp_fallback), when that is
+// within the limits and clear of the table (the ramp's intermediate shapes are not checked). A
+// line the executor refuses while running (it starts from where the arm's shape target is, not
+// the planned pose) also falls back to a ramp.
+// Deterministic; allocation only when a move is planned, its carry re-checked at the grasp or a
+// ramp set up (path set-ups copy the executor).
 #pragma once
 
 #include <Eigen/Core>
@@ -37,6 +45,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -61,6 +70,7 @@ struct ExpertConfig {
   double max_node_speed = 0.9;      ///< m/s, planned peak speed of any rod node (gripper empty)
   double carry_peak_speed = 0.9;    ///< m/s, the same while an object is held
   double carry_node_speed = 0.9;    ///< m/s
+  double path_cruise = 0.0;         ///< fraction of a path at constant speed (0: quintic timing; ModelExecutor::track_line)
   int min_segment_steps = 60;       ///< shortest path, control steps
   double settle_speed = 0.05;       ///< m/s: close / open only when the arm's tip is slower
   double settle_error = 0.01;       ///< m: and the end-effector this near its pose
@@ -70,7 +80,6 @@ struct ExpertConfig {
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
   int max_retries = 1;              ///< re-tries of a missed grasp
   double approach_distance = 0.06;  ///< m: the approach pose this far from the grasp, along the annotation's approach direction
-  int detours = 0;                  ///< detour points tried for a refused line (0-5)
   bool ramp_fallback = true;        ///< a refused line may be replaced by a shape ramp
 };
 
@@ -108,7 +117,7 @@ class Expert {
   using Executor = TaskEnv::Executor;
 
   explicit Expert(const TaskEnv& env, ExpertConfig config = {})
-      : env_(&env), config_(config), executor_(env.home_executor()), planner_(env.home_executor()), planner_backup_(env.home_executor()), planner_detour_(env.home_executor()) {
+      : env_(&env), config_(config), executor_(env.home_executor()), planner_(env.home_executor()), planner_backup_(env.home_executor()) {
     const int n = env.arm_model().rod.n_elements;
     observation_ = control::make_arm_observation<double>(n, env.config().observe_stride);
     events_.reserve(64);
@@ -155,16 +164,11 @@ class Expert {
   /// The lines of a leg, in order; a "ramp" line is the executor's shape ramp to the pose's cold
   /// inverse statics solution instead of a straight line (the fallback of a refused line).
   struct Leg {
-    std::array<Pose, 8> pose;
-    std::array<bool, 8> ramp{};
+    std::array<Pose, 4> pose;
+    std::array<bool, 4> ramp{};
     int count = 0;
     void clear() { count = 0; }
-    void push(const Pose& p, bool r = false) { pose[static_cast<std::size_t>(count)] = p, ramp[static_cast<std::size_t>(count)] = r, ++count; }
-    void insert(int i, const Pose& p, bool r) {
-      for (int j = count; j > i; --j) pose[static_cast<std::size_t>(j)] = pose[static_cast<std::size_t>(j - 1)], ramp[static_cast<std::size_t>(j)] = ramp[static_cast<std::size_t>(j - 1)];
-      pose[static_cast<std::size_t>(i)] = p, ramp[static_cast<std::size_t>(i)] = r, ++count;
-    }
-    bool full() const { return count >= static_cast<int>(pose.size()); }
+    void push(const Pose& p) { pose[static_cast<std::size_t>(count)] = p, ramp[static_cast<std::size_t>(count)] = false, ++count; }
   };
   struct Plan {
     int object = -1;
@@ -356,7 +360,11 @@ class Expert {
     }
     std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
     plan_refusal_ = candidates.empty() ? "the asset has no grasp annotation" : "";
-    for (auto& c : candidates) {
+    // first pass: straight lines only; second: refused lines repaired (check_leg)
+    for (int pass = 0; pass < 2; ++pass) {
+    repair_ = pass == 1;
+    if (repair_ && !config_.ramp_fallback) break;
+    for (auto c : candidates) {
       planner_ = executor_;
       planner_.complete_path();
       const char* why = "";
@@ -369,20 +377,12 @@ class Expert {
         if (!(ok = check_leg(c.plan.carry_leg, why))) where = "carry";
       }
       if (ok && !(ok = check_line(c.plan.place, why))) where = "place";
-#ifdef MANISOFT_EXPERT_TRACE
-      if (getenv("PLANTRACE")) {
-        std::fprintf(stderr, "    [cand] cost %.3f via %d%d ok %d %s %s grasp (%.3f %.3f %.3f) place (%.3f %.3f %.3f):", c.cost, int(c.plan.via_approach), int(c.plan.via_carry), int(ok), where, why,
-          c.plan.grasp.translation.x(), c.plan.grasp.translation.y(), c.plan.grasp.translation.z(), c.plan.place.translation.x(), c.plan.place.translation.y(), c.plan.place.translation.z());
-        for (int i = 0; i < c.plan.approach_leg.count; ++i) std::fprintf(stderr, " a%s(%.3f %.3f %.3f)", c.plan.approach_leg.ramp[i] ? "R" : "", c.plan.approach_leg.pose[i].translation.x(), c.plan.approach_leg.pose[i].translation.y(), c.plan.approach_leg.pose[i].translation.z());
-        for (int i = 0; i < c.plan.carry_leg.count; ++i) std::fprintf(stderr, " c%s(%.3f %.3f %.3f)", c.plan.carry_leg.ramp[i] ? "R" : "", c.plan.carry_leg.pose[i].translation.x(), c.plan.carry_leg.pose[i].translation.y(), c.plan.carry_leg.pose[i].translation.z());
-        std::fprintf(stderr, "\n");
-      }
-#endif
       if (ok) {
         plan_ = c.plan;
         return true;
       }
       if (plan_refusal_.empty()) plan_refusal_ = std::string(where) + ": " + why;
+    }
     }
     return false;
   }
@@ -392,7 +392,7 @@ class Expert {
   /// within table_clearance of the table top.
   bool check_line(const Pose& to, const char*& why) {
     planner_backup_ = planner_;
-    const auto report = planner_.track_line(to, 100);
+    const auto report = planner_.track_line(to, 100, std::numeric_limits<double>::infinity(), config_.path_cruise);
     planner_.complete_path();
     if (!report.accepted) {
       why = report.reason;
@@ -418,55 +418,16 @@ class Expert {
     return false;
   }
 
-  /// Checks a leg's lines on planner_; a refused line is retried after a detour point inserted
-  /// before it (see detour()), then as a ramp. False when a line has no acceptable detour.
+  /// Checks a leg's lines on planner_; in the repair pass a refused line becomes a shape ramp
+  /// when check_ramp() accepts it. False when a line is refused.
   bool check_leg(Leg& leg, const char*& why) {
     for (int i = 0; i < leg.count; ++i) {
-      const Pose from = planner_.statics().desired_tip_pose();
-      const Pose to = leg.pose[static_cast<std::size_t>(i)];
-      if (leg.ramp[static_cast<std::size_t>(i)] ? check_ramp(to) : check_line(to, why)) continue;
-      bool repaired = false;
-      for (int d = 0; d < config_.detours && !repaired && !leg.full(); ++d) {
-        const Pose via = detour(from, to, d);
-        const char* ignored = "";
-        planner_detour_ = planner_;
-        if (check_line(via, ignored) && check_line(to, ignored)) {
-          leg.insert(i, via, false);
-          ++i;  // `to` is checked already
-          repaired = true;
-#ifdef MANISOFT_EXPERT_TRACE
-          if (getenv("PLANTRACE")) std::fprintf(stderr, "      detour %d repaired (%s)\n", d, why);
-#endif
-        } else {
-          planner_ = planner_detour_;
-        }
-      }
-      if (!repaired && config_.ramp_fallback && check_ramp(to)) {
-        leg.ramp[static_cast<std::size_t>(i)] = true;
-        repaired = true;
-#ifdef MANISOFT_EXPERT_TRACE
-        if (getenv("PLANTRACE")) std::fprintf(stderr, "      ramp repaired (%s)\n", why);
-#endif
-      }
-      if (!repaired) return false;
+      const auto k = static_cast<std::size_t>(i);
+      if (leg.ramp[k] ? check_ramp(leg.pose[k]) : check_line(leg.pose[k], why)) continue;
+      if (!repair_ || !config_.ramp_fallback || !check_ramp(leg.pose[k])) return false;
+      leg.ramp[k] = true;
     }
     return true;
-  }
-
-  /// Detour points of a refused line from -> to: turn first, move first, the midpoint raised
-  /// or lowered (half the turn there).
-  Pose detour(const Pose& from, const Pose& to, int kind) const {
-    Pose via;
-    via.translation = 0.5 * (from.translation + to.translation);
-    via.rotation = Eigen::Quaterniond(from.rotation).slerp(0.5, Eigen::Quaterniond(to.rotation)).toRotationMatrix();
-    switch (kind) {
-      case 0: via.translation = from.translation, via.rotation = to.rotation; break;
-      case 1: via.translation = to.translation, via.rotation = from.rotation; break;
-      case 2: via.translation.z() += 0.08; break;
-      case 3: via.translation.z() -= 0.05; break;
-      default: via.translation.z() += 0.16; break;
-    }
-    return via;
   }
 
   void begin_move() {
@@ -508,16 +469,27 @@ class Expert {
     const bool loaded = s_ == 1;
     const double peak = loaded ? config_.carry_peak_speed : config_.path_peak_speed;
     const double node = loaded ? config_.carry_node_speed : config_.max_node_speed;
-    const int steps = std::max(config_.min_segment_steps, static_cast<int>(std::ceil(1.875 * distance / peak / control_dt)));
-    const auto report = executor_.track_line(goal, steps, node * control_dt);
-#ifdef MANISOFT_EXPERT_TRACE
-    std::fprintf(stderr, "  [path] step %ld phase %d leg %d dist %.3f to (%.3f %.3f %.3f) steps %d -> %d ok %d %s\n", steps_, int(phase_), leg_, distance,
-                 goal.translation.x(), goal.translation.y(), goal.translation.z(), steps, report.steps, int(report.accepted), report.reason);
-#endif
+    // peak speed / mean speed of the timing
+    const double peak_ratio = config_.path_cruise > 0 ? 2 / (1 + config_.path_cruise) : 1.875;
+    const int steps = std::max(config_.min_segment_steps, static_cast<int>(std::ceil(peak_ratio * distance / peak / control_dt)));
+    const auto report = executor_.track_line(goal, steps, node * control_dt, config_.path_cruise);
     if (!report.accepted) {
+      // the executor's shape ramp to the goal's cold solution instead, when it has one
+      if (config_.ramp_fallback && start_ramp(goal)) return true;
       if (required) give_up(report.reason);
       return false;
     }
+    target_ = goal;
+    return true;
+  }
+
+  /// Starts the executor's shape ramp to `goal` (set_target); false (nothing changed but the
+  /// executor's target) when the goal has no inverse statics solution within the limits.
+  bool start_ramp(const Pose& goal) {
+    planner_ = executor_;
+    const auto r = planner_.set_target(goal);
+    if (!r.within_limits) return false;
+    executor_.set_target(goal);
     target_ = goal;
     return true;
   }
@@ -529,16 +501,7 @@ class Expert {
       start_path(leg.pose[k]);
       return;
     }
-    const auto r = executor_.set_target(leg.pose[k]);
-#ifdef MANISOFT_EXPERT_TRACE
-    std::fprintf(stderr, "  [ramp] step %ld phase %d leg %d to (%.3f %.3f %.3f) steps %d ok %d\n", steps_, int(phase_), leg_,
-                 leg.pose[k].translation.x(), leg.pose[k].translation.y(), leg.pose[k].translation.z(), executor_.ramp_length(), int(r.within_limits));
-#endif
-    if (!r.within_limits) {
-      give_up("a ramp target has no inverse statics solution within the actuation limits");
-      return;
-    }
-    target_ = leg.pose[k];
+    if (!start_ramp(leg.pose[k])) give_up("a ramp target has no inverse statics solution within the actuation limits");
   }
 
   /// Whether something under the held object carries it (see the lower phase).
@@ -603,8 +566,9 @@ class Expert {
         plan_.place = plan_.object_target * object.inverse() * ee;
         set_carry_leg(plan_);
         {
-          // the corrected carry, checked (and repaired with detours) from here
+          // the corrected carry, checked (and repaired) from here
           Plan checked = plan_;
+          repair_ = true;
           planner_ = executor_;
           planner_.complete_path();
           const char* why = "";
@@ -666,7 +630,7 @@ class Expert {
 
   const TaskEnv* env_;
   ExpertConfig config_;
-  Executor executor_, planner_, planner_backup_, planner_detour_;
+  Executor executor_, planner_, planner_backup_;
   control::Observation<double> observation_;
   Pose target_;
   Plan plan_;
@@ -675,7 +639,8 @@ class Expert {
   long steps_ = 0;
   std::vector<ExpertEvent> events_;
   const char* failure_ = nullptr;
-  std::string plan_refusal_;  ///< why the least-turning grasp candidate was refused
+  std::string plan_refusal_;
+  bool repair_ = true;  ///< check_leg may repair refused lines  ///< why the least-turning grasp candidate was refused
 };
 
 }  // namespace manisoft::task
