@@ -8,8 +8,8 @@ packages+=(libegl-dev libgl-dev libegl1-mesa-dev libgl1-mesa-dri libegl-mesa0 li
 packages+=(libassimp-dev nlohmann-json3-dev)
 # dataset component: HDF5 files; h5py and numpy for the Python reader (Debian's /usr/bin/python3)
 packages+=(libhdf5-dev python3-h5py python3-numpy)
-# sharded dataset generation on one machine (and its test)
-packages+=(parallel)
+# sharded dataset generation on one machine (and its test); the dataset's plots and zarr export
+packages+=(parallel python3-matplotlib python3-zarr)
 # the Python module (pybind11, for Debian's /usr/bin/python3)
 packages+=(pybind11-dev python3-dev)
 # the evaluation harness's policy-server client (openpi's websocket + msgpack protocol)

@@ -3,10 +3,12 @@
 # episodes) made as 1 shard and as 3 shards run by GNU parallel with --index-only as the merge
 # step must be identical file for file, bit for bit; a run killed mid-way and resumed must give the
 # same files; verify_dataset accepts it, and names a truncated episode file; the h5py reader
-# (examples/python/read_dataset.py) reads it.
+# (examples/python/read_dataset.py) reads it; dataset_stats.py draws its plots and export_zarr.py
+# writes Diffusion Policy's zarr layout with the same actions.
 # Usage: generate_dataset_test.sh GENERATE VERIFY READ_DATASET_PY PYTHON
 set -euo pipefail
 gen=$1 verify=$2 reader=$3 python=$4
+examples=$(dirname "$reader")
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 args=(--tasks ALN,ARR --clean 3 --randomized 3 --seed 7)
@@ -46,4 +48,21 @@ grep -q "demo_4.hdf5" <<< "$out" || { echo "FAIL: verify_dataset did not name th
 
 # robomimic-style reading with h5py alone
 "$python" "$reader" "$work/one" | grep -q "demos 6 "
-echo "generate_dataset: 1 shard == 3 shards == killed + resumed; verify and h5py read OK"
+
+# the paper's figure 4 plots and table, and Diffusion Policy's zarr layout
+"$python" "$examples/dataset_stats.py" "$work/one" --out "$work/stats" > /dev/null
+for f in lengths categories heatmap instructions; do [[ -s $work/stats/$f.png ]] || { echo "FAIL: no $f.png"; exit 1; }; done
+grep -q "| all | all | 6 |" "$work/stats/stats.md" || { echo "FAIL: stats.md lacks the 6-episode total"; exit 1; }
+"$python" "$examples/export_zarr.py" "$work/one" "$work/one.zarr" --split all > /dev/null
+"$python" - "$work/one" "$work/one.zarr" <<'PY'
+import sys, h5py, numpy as np, zarr
+with h5py.File(sys.argv[1] + "/dataset.hdf5", "r") as f:
+    demos = [f["data"][f"demo_{k}"] for k in range(6)]
+    actions = np.concatenate([d["actions"][()] for d in demos])
+    ends = np.cumsum([d["actions"].shape[0] for d in demos])
+z = zarr.open_group(sys.argv[2], mode="r")
+assert np.array_equal(z["meta/episode_ends"][:], ends), "episode_ends"
+assert np.array_equal(z["data/action"][:], actions), "actions"
+assert z["data/rod_centerline"].shape == (ends[-1], 63), z["data/rod_centerline"].shape
+PY
+echo "generate_dataset: 1 shard == 3 shards == killed + resumed; verify, h5py read, stats and zarr export OK"
