@@ -9,7 +9,9 @@
 // within a setting, the tasks take turns (j-th episode of the setting: task j mod T, its
 // (j div T)-th of that task). Its scene is train-split scene index (j div T) * A + a for draw
 // a = 0, 1, ...: the first draw whose expert episode succeeds is kept (the paper's quality check:
-// only successful expert episodes), the others are redrawn and counted with their reason. So the
+// only successful expert episodes), the others are redrawn and counted with their reason. Images
+// (--images every:K) are rendered while the kept episode's actions replay, so failed draws cost
+// physics only. So the
 // same dataset comes out as one shard or as n shards (--shard i/n takes k = i, i + n, ...), with
 // any --jobs: file for file, bit for bit.
 // Atomic and resumable: an episode is written under a temporary name and renamed when complete;
@@ -93,21 +95,16 @@ class Worker {
       env_.reset(spec);
       expert_.reset();
       ms::dataset::EpisodeRecorder recorder(env_);
-      ms::dataset::ImageSequence images;
       ms::task::TaskEnv::Array3 torques;
       int s = 0;
-      long step = 0;
-      if (plan_.image_every > 0) begin_images(spec, images);
       while (!env_.done()) {
         expert_.act(torques, s);
-        if (plan_.image_every > 0 && step % plan_.image_every == 0) add_image(images, step);
         recorder.step(torques, s);
         env_.step(torques, s);
-        ++step;
       }
       if (env_.info().success) {
         ms::dataset::Episode e = recorder.finish(k, plan_.seed, a);
-        if (plan_.image_every > 0) e.images["agentview_image"] = std::move(images);
+        if (plan_.image_every > 0) e.images["agentview_image"] = render_replay(spec, e);
         return e;
       }
       const std::string why = expert_.failure()[0] ? "expert: " + std::string(expert_.failure()) : std::string(ms::task::to_string(env_.info().failure));
@@ -118,6 +115,23 @@ class Worker {
   }
 
  private:
+  /// The images of a kept episode, every image_every steps, rendered while its actions replay
+  /// (the replay is exact: failed draws cost no rendering).
+  ms::dataset::ImageSequence render_replay(const ms::scene::SceneSpec& spec, const ms::dataset::Episode& e) {
+    ms::dataset::ImageSequence images;
+    begin_images(spec, images);
+    env_.reset(spec);
+    const int n = static_cast<int>(e.actions.cols() - 1) / 3;
+    ms::task::TaskEnv::Array3 torques(n, 3);
+    for (long r = 0; r < e.steps(); ++r) {
+      if (r % plan_.image_every == 0) add_image(images, r);
+      for (int j = 0; j < n; ++j)
+        for (int c = 0; c < 3; ++c) torques(j, c) = e.actions(r, 3 * j + c);
+      env_.step(torques, static_cast<int>(e.actions(r, 3 * n)));
+    }
+    return images;
+  }
+
   void begin_images(const ms::scene::SceneSpec& spec, ms::dataset::ImageSequence& images) {
     if (!gl_) {
       ms::render::GlRendererOptions o;
