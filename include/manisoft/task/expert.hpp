@@ -75,9 +75,6 @@ struct ExpertConfig {
   double settle_speed = 0.05;       ///< m/s: close / open only when the arm's tip is slower
   double settle_error = 0.01;       ///< m: and the end-effector this near its pose
   int max_settle_steps = 200;       ///< longest wait for settling (then act anyway)
-  double release_settle_speed = 0.0;  ///< m/s: once the support carries the object, stop and open only when the arm's tip is slower (0: open at once)
-  double release_lift = 0.005;      ///< m: the stop above where the arm is (release_settle_speed)
-  double carry_settle_speed = 0.0;  ///< m/s: lower only once the arm's tip is slower at the end of the carry (0: at once)
   double start_error = 0.015;       ///< m: a chained path starts once the previous one is this near
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
@@ -134,7 +131,6 @@ class Expert {
     retries_ = 0;
     s_ = 0;
     waited_ = 0;
-    touched_ = false;
     steps_ = 0;
     events_.clear();
     failure_ = nullptr;
@@ -589,10 +585,9 @@ class Expert {
           break;
         }
         if (done && error < config_.start_error) {
-          if (leg_ + 1 < plan_.carry_leg.count) {
-            start_leg(plan_.carry_leg, ++leg_);
-          } else if (!(config_.carry_settle_speed > 0) || speed < config_.carry_settle_speed || ++waited_ > config_.max_settle_steps) {
-            waited_ = 0;
+          if (++leg_ < plan_.carry_leg.count) {
+            start_leg(plan_.carry_leg, leg_);
+          } else {
             enter(ExpertPhase::lower);
             start_path(plan_.place);
           }
@@ -606,20 +601,7 @@ class Expert {
         // Its support already carries the object (it touches the table or another object, or
         // sank half the clearance below the release height): open now rather than press it in
         // until it slips.
-        // With release_settle_speed, the arm stops where it is first and opens once its tip is
-        // slower (a tall object let go while the arm still sways tips over).
-        if (!touched_ && supported(state_of(plan_.object))) {
-          touched_ = true;
-          waited_ = 0;
-          if (config_.release_settle_speed > 0 && !done) {
-            Pose hold{f.rotation, f.position};  // where the arm is, lifted so it does not press on
-            hold.translation.z() += config_.release_lift;
-            start_path(hold, false);
-          }
-        }
-        if (touched_ ? (!(config_.release_settle_speed > 0) || speed < config_.release_settle_speed || ++waited_ > config_.max_settle_steps)
-                     : (done && (settled || ++waited_ > config_.max_settle_steps))) {
-          touched_ = false;
+        if ((done && (settled || ++waited_ > config_.max_settle_steps)) || supported(state_of(plan_.object))) {
           waited_ = 0;
           s_ = 0;
           executor_.set_payload(0.0);
@@ -657,9 +639,8 @@ class Expert {
   long steps_ = 0;
   std::vector<ExpertEvent> events_;
   const char* failure_ = nullptr;
-  std::string plan_refusal_;  ///< why the least-turning grasp candidate was refused
-  bool repair_ = true;        ///< check_leg may repair refused lines
-  bool touched_ = false;      ///< the lower phase found the object supported
+  std::string plan_refusal_;
+  bool repair_ = true;  ///< check_leg may repair refused lines  ///< why the least-turning grasp candidate was refused
 };
 
 }  // namespace manisoft::task
