@@ -24,8 +24,10 @@
 // above it), grasp, close once settled
 // (the arm's tip slower than settle_speed), carry (above the place pose, diagonal from the grasp;
 // "via": first straight up by lift_height), place (corrected for where the object sits in the
-// hand, measured when it is held), open once settled or as soon as the support carries the
-// object, then up until the fingertips clear the object's top (after the last move too). A
+// hand, measured when it is held; lowered once the arm's tip is slower than carry_settle_speed),
+// open once settled or as soon as the support carries the object (a tall one: the arm stops
+// there, release_lift up, and opens once its tip is slower than release_settle_speed), then up
+// until the fingertips clear the object's top (after the last move too). A
 // leg whose straight line would pass towards the inner edge of the arm's reach (arc_inset nearer
 // its base than its farther end) goes round an arc point about the base instead. A missed grasp
 // re-opens and retries the move from its approach (max_retries).
@@ -70,11 +72,15 @@ struct ExpertConfig {
   double max_node_speed = 0.9;      ///< m/s, planned peak speed of any rod node (gripper empty)
   double carry_peak_speed = 0.9;    ///< m/s, the same while an object is held
   double carry_node_speed = 0.9;    ///< m/s
-  double path_cruise = 0.0;         ///< fraction of a path at constant speed (0: quintic timing; ModelExecutor::track_line)
+  double path_cruise = 0.5;         ///< fraction of a path at constant speed (0: quintic timing; ModelExecutor::track_line)
   int min_segment_steps = 60;       ///< shortest path, control steps
   double settle_speed = 0.05;       ///< m/s: close / open only when the arm's tip is slower
   double settle_error = 0.01;       ///< m: and the end-effector this near its pose
   int max_settle_steps = 200;       ///< longest wait for settling (then act anyway)
+  double release_settle_speed = 0.05;  ///< m/s: once the support carries a tall object, stop and open only when the arm's tip is slower (0: open at once)
+  double tall_ratio = 1.2;          ///< an object is tall (release_settle_speed) above this height / width
+  double release_lift = 0.005;      ///< m: the stop above where the arm is (release_settle_speed)
+  double carry_settle_speed = 0.1;  ///< m/s: lower only once the arm's tip is slower at the end of the carry (0: at once)
   double start_error = 0.015;       ///< m: a chained path starts once the previous one is this near
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
@@ -131,6 +137,7 @@ class Expert {
     retries_ = 0;
     s_ = 0;
     waited_ = 0;
+    touched_ = false;
     steps_ = 0;
     events_.clear();
     failure_ = nullptr;
@@ -504,6 +511,14 @@ class Expert {
     if (!start_ramp(leg.pose[k])) give_up("a ramp target has no inverse statics solution within the actuation limits");
   }
 
+  /// Whether the held object is let go only once the arm is still (release_settle_speed): a
+  /// tall one (height above tall_ratio x its width).
+  bool release_settles() const {
+    if (!(config_.release_settle_speed > 0)) return false;
+    const auto& a = asset_of(plan_.object);
+    return scene::asset_height(a) > config_.tall_ratio * 2 * std::max(a.bounding_half_extents.x(), a.bounding_half_extents.y());
+  }
+
   /// Whether something under the held object carries it (see the lower phase).
   bool supported(const ObjectState& o) const {
     return o.touching != 0 || o.touches_table || o.pose.translation.z() < plan_.object_target.translation.z() - 0.5 * config_.place_clearance;
@@ -585,9 +600,10 @@ class Expert {
           break;
         }
         if (done && error < config_.start_error) {
-          if (++leg_ < plan_.carry_leg.count) {
-            start_leg(plan_.carry_leg, leg_);
-          } else {
+          if (leg_ + 1 < plan_.carry_leg.count) {
+            start_leg(plan_.carry_leg, ++leg_);
+          } else if (!(config_.carry_settle_speed > 0) || speed < config_.carry_settle_speed || ++waited_ > config_.max_settle_steps) {
+            waited_ = 0;
             enter(ExpertPhase::lower);
             start_path(plan_.place);
           }
@@ -601,7 +617,20 @@ class Expert {
         // Its support already carries the object (it touches the table or another object, or
         // sank half the clearance below the release height): open now rather than press it in
         // until it slips.
-        if ((done && (settled || ++waited_ > config_.max_settle_steps)) || supported(state_of(plan_.object))) {
+        // With release_settle_speed, the arm stops where it is first and opens once its tip is
+        // slower (a tall object let go while the arm still sways tips over).
+        if (!touched_ && supported(state_of(plan_.object))) {
+          touched_ = true;
+          waited_ = 0;
+          if (release_settles()) {
+            Pose hold{f.rotation, f.position};  // where the arm is, lifted so it does not press on
+            hold.translation.z() += config_.release_lift;
+            start_path(hold, false);
+          }
+        }
+        if (touched_ ? (!release_settles() || speed < config_.release_settle_speed || ++waited_ > config_.max_settle_steps)
+                     : (done && (settled || ++waited_ > config_.max_settle_steps))) {
+          touched_ = false;
           waited_ = 0;
           s_ = 0;
           executor_.set_payload(0.0);
@@ -639,8 +668,9 @@ class Expert {
   long steps_ = 0;
   std::vector<ExpertEvent> events_;
   const char* failure_ = nullptr;
-  std::string plan_refusal_;
-  bool repair_ = true;  ///< check_leg may repair refused lines  ///< why the least-turning grasp candidate was refused
+  std::string plan_refusal_;  ///< why the least-turning grasp candidate was refused
+  bool repair_ = true;        ///< check_leg may repair refused lines
+  bool touched_ = false;      ///< the lower phase found the object supported
 };
 
 }  // namespace manisoft::task
