@@ -33,10 +33,9 @@
 #include <thread>
 #include <vector>
 
-#include "../render/spec_render_scene.hpp"
+#include "episode_images.hpp"
 #include "manisoft/dataset/dataset_index.hpp"
 #include "manisoft/dataset/expert_recording.hpp"
-#include "manisoft/render/gl_renderer.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/task/expert.hpp"
 
@@ -83,7 +82,8 @@ struct Plan {
 /// One worker: its own sampler, environment, expert (and renderer when images are asked for).
 class Worker {
  public:
-  explicit Worker(const Plan& plan) : plan_(plan), env_(sampler_.library()), expert_(env_) {}
+  explicit Worker(const Plan& plan)
+      : plan_(plan), env_(sampler_.library()), expert_(env_), images_(plan.image_width, plan.image_height) {}
 
   /// The kept episode k, and the reasons of the draws redrawn before it.
   ms::dataset::Episode make(long k, std::map<std::string, long>& redraw_reasons) {
@@ -104,7 +104,7 @@ class Worker {
       }
       if (env_.info().success) {
         ms::dataset::Episode e = recorder.finish(k, plan_.seed, a);
-        if (plan_.image_every > 0) e.images["agentview_image"] = render_replay(spec, e);
+        if (plan_.image_every > 0) e.images["agentview_image"] = images_.render(env_, spec, e, plan_.image_every);
         return e;
       }
       const std::string why = expert_.failure()[0] ? "expert: " + std::string(expert_.failure()) : std::string(ms::task::to_string(env_.info().failure));
@@ -115,68 +115,11 @@ class Worker {
   }
 
  private:
-  /// The images of a kept episode, every image_every steps, rendered while its actions replay
-  /// (the replay is exact: failed draws cost no rendering).
-  ms::dataset::ImageSequence render_replay(const ms::scene::SceneSpec& spec, const ms::dataset::Episode& e) {
-    ms::dataset::ImageSequence images;
-    begin_images(spec, images);
-    env_.reset(spec);
-    const int n = static_cast<int>(e.actions.cols() - 1) / 3;
-    ms::task::TaskEnv::Array3 torques(n, 3);
-    for (long r = 0; r < e.steps(); ++r) {
-      if (r % plan_.image_every == 0) add_image(images, r);
-      for (int j = 0; j < n; ++j)
-        for (int c = 0; c < 3; ++c) torques(j, c) = e.actions(r, 3 * j + c);
-      env_.step(torques, static_cast<int>(e.actions(r, 3 * n)));
-    }
-    return images;
-  }
-
-  void begin_images(const ms::scene::SceneSpec& spec, ms::dataset::ImageSequence& images) {
-    if (!gl_) {
-      ms::render::GlRendererOptions o;
-      o.read_depth = false;
-      o.read_mask = false;
-      gl_ = std::make_unique<ms::render::GlRenderer>(o);
-    }
-    scene_ = ms::render::spec::make_spec_scene(spec, sampler_.library());
-    ms::render::Camera camera = spec.cameras.front();
-    camera.width = plan_.image_width;
-    camera.height = plan_.image_height;
-    scene_.scene.cameras = {camera};
-    gl_->set_scene(scene_.scene);
-    images = {};
-    images.width = plan_.image_width;
-    images.height = plan_.image_height;
-  }
-
-  void add_image(ms::dataset::ImageSequence& images, long step) {
-    const auto& w = env_.world();
-    ms::render::FrameState frame = scene_.frame;
-    frame.rod.nodes = w.rod().state().positions;
-    frame.rod.directors.resize(0, 9);
-    const ms::math::Pose<double> gripper{w.rigid().orientation(w.gripper_body()).toRotationMatrix(), w.rigid().position(w.gripper_body())};
-    ms::render::tabletop::set_gripper(scene_, frame, gripper, w.gripper().finger_width());
-    const auto& objects = env_.bodies().objects;
-    for (std::size_t i = 0; i < scene_.scene.instances.size(); ++i) {
-      const std::string& n = scene_.scene.instances[i].name;
-      if (n.rfind("object", 0) != 0) continue;
-      const std::size_t k = std::stoul(n.substr(6, n.find(' ') - 6));
-      frame.instance_poses[i] = {w.rigid().orientation(objects[k]).toRotationMatrix(), w.rigid().position(objects[k])};
-    }
-    gl_->render_into(frame, out_);
-    images.pixels.insert(images.pixels.end(), out_.rgb.begin(), out_.rgb.end());
-    images.steps.push_back(step);
-    ++images.frames;
-  }
-
   const Plan& plan_;
   ms::scene::SceneSampler sampler_;
   ms::task::TaskEnv env_;
   ms::task::Expert expert_;
-  std::unique_ptr<ms::render::GlRenderer> gl_;
-  ms::render::tabletop::TabletopScene scene_;
-  ms::render::RenderOutput out_;
+  manisoft_examples::EpisodeImages images_;  // rendered while a kept episode's actions replay: failed draws cost physics only
 };
 
 std::vector<ms::scene::Task> parse_tasks(const std::string& list) {

@@ -5,9 +5,10 @@
 # same files; verify_dataset accepts it, and names a truncated episode file; the h5py reader
 # (examples/python/read_dataset.py) reads it; dataset_stats.py draws its plots and export_zarr.py
 # writes Diffusion Policy's zarr layout with the same actions.
-# Usage: generate_dataset_test.sh GENERATE VERIFY READ_DATASET_PY PYTHON
+# render_dataset renders the images of a states-only dataset equal to those generated with it.
+# Usage: generate_dataset_test.sh GENERATE VERIFY READ_DATASET_PY PYTHON RENDER_DATASET
 set -euo pipefail
-gen=$1 verify=$2 reader=$3 python=$4
+gen=$1 verify=$2 reader=$3 python=$4 render=$5
 examples=$(dirname "$reader")
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -45,6 +46,20 @@ cp -r "$work/one" "$work/cut"
 truncate -s 5000 "$work/cut/episodes/demo_4.hdf5"
 if out=$("$verify" "$work/cut" 2>&1); then echo "FAIL: verify_dataset accepted a truncated file"; exit 1; fi
 grep -q "demo_4.hdf5" <<< "$out" || { echo "FAIL: verify_dataset did not name the file: $out"; exit 1; }
+
+# physics first, images later: the same dataset generated with images equals render_dataset's
+# images of the states-only one, bit for bit
+"$gen" "${args[@]}" --out "$work/images" --images every:50 --image-size 48 40 > /dev/null
+"$render" "$work/one" --out "$work/rendered" --every 50 --image-size 48 40 > /dev/null 2>&1
+"$python" - "$work/images" "$work/rendered" <<'PY'
+import sys, h5py, numpy as np
+for k in range(6):
+    with h5py.File(f"{sys.argv[1]}/episodes/demo_{k}.hdf5", "r") as a, h5py.File(f"{sys.argv[2]}/demo_{k}.hdf5", "r") as b:
+        x, y = a[f"data/demo_{k}/images/agentview_image"][()], b[f"data/demo_{k}/images/agentview_image"][()]
+        assert x.shape[1:] == (40, 48, 3) and x.shape[0] >= 10, x.shape
+        assert np.array_equal(x, y), f"demo_{k}: rendered images differ"
+        assert np.array_equal(a[f"data/demo_{k}/images/agentview_image_steps"][()], np.arange(0, 50 * len(x), 50))
+PY
 
 # robomimic-style reading with h5py alone
 "$python" "$reader" "$work/one" | grep -q "demos 6 "

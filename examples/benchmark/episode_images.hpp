@@ -1,0 +1,87 @@
+// Camera images of a recorded episode, rendered while its actions replay in a TaskEnv (the replay
+// is exact, so the images are those of the original run): generate_dataset (--images every:K)
+// and render_dataset ("physics first, images later") share it. OpenGL through EGL
+// (render::GlRenderer, colour only), the scene drawn as examples/render/spec_render_scene.hpp does.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "../render/spec_render_scene.hpp"
+#include "manisoft/dataset/episode.hpp"
+#include "manisoft/render/gl_renderer.hpp"
+#include "manisoft/task/task_env.hpp"
+
+namespace manisoft_examples {
+
+class EpisodeImages {
+ public:
+  /// `camera`: the view (its width and height are the images'); unset: each scene's own camera
+  /// at width x height.
+  EpisodeImages(int width, int height, std::optional<manisoft::render::Camera> camera = std::nullopt)
+      : width_(width), height_(height), camera_(camera) {}
+
+  /// Replays `e` (actions) from `spec` in `env`, an image every `every` control steps from step 0.
+  manisoft::dataset::ImageSequence render(manisoft::task::TaskEnv& env, const manisoft::scene::SceneSpec& spec, const manisoft::dataset::Episode& e,
+                                          int every) {
+    manisoft::dataset::ImageSequence images;
+    images.width = width_;
+    images.height = height_;
+    set_scene(spec, env.library());
+    env.reset(spec);
+    const int n = static_cast<int>(e.actions.cols() - 1) / 3;
+    manisoft::task::TaskEnv::Array3 torques(n, 3);
+    for (long r = 0; r < e.steps(); ++r) {
+      if (r % every == 0) add_image(env, images, r);
+      for (int j = 0; j < n; ++j)
+        for (int c = 0; c < 3; ++c) torques(j, c) = e.actions(r, 3 * j + c);
+      env.step(torques, static_cast<int>(e.actions(r, 3 * n)));
+    }
+    return images;
+  }
+
+ private:
+  void set_scene(const manisoft::scene::SceneSpec& spec, const manisoft::scene::AssetLibrary& library) {
+    if (!gl_) {
+      manisoft::render::GlRendererOptions o;
+      o.read_depth = false;
+      o.read_mask = false;
+      gl_ = std::make_unique<manisoft::render::GlRenderer>(o);
+    }
+    scene_ = manisoft::render::spec::make_spec_scene(spec, library);
+    manisoft::render::Camera camera = camera_ ? *camera_ : spec.cameras.front();
+    camera.width = width_;
+    camera.height = height_;
+    scene_.scene.cameras = {camera};
+    gl_->set_scene(scene_.scene);
+  }
+
+  void add_image(const manisoft::task::TaskEnv& env, manisoft::dataset::ImageSequence& images, long step) {
+    const auto& w = env.world();
+    manisoft::render::FrameState frame = scene_.frame;
+    frame.rod.nodes = w.rod().state().positions;
+    frame.rod.directors.resize(0, 9);
+    const manisoft::math::Pose<double> gripper{w.rigid().orientation(w.gripper_body()).toRotationMatrix(), w.rigid().position(w.gripper_body())};
+    manisoft::render::tabletop::set_gripper(scene_, frame, gripper, w.gripper().finger_width());
+    const auto& objects = env.bodies().objects;
+    for (std::size_t i = 0; i < scene_.scene.instances.size(); ++i) {
+      const std::string& name = scene_.scene.instances[i].name;
+      if (name.rfind("object", 0) != 0) continue;
+      const std::size_t k = std::stoul(name.substr(6, name.find(' ') - 6));
+      frame.instance_poses[i] = {w.rigid().orientation(objects[k]).toRotationMatrix(), w.rigid().position(objects[k])};
+    }
+    gl_->render_into(frame, out_);
+    images.pixels.insert(images.pixels.end(), out_.rgb.begin(), out_.rgb.end());
+    images.steps.push_back(step);
+    ++images.frames;
+  }
+
+  int width_, height_;
+  std::optional<manisoft::render::Camera> camera_;
+  std::unique_ptr<manisoft::render::GlRenderer> gl_;
+  manisoft::render::tabletop::TabletopScene scene_;
+  manisoft::render::RenderOutput out_;
+};
+
+}  // namespace manisoft_examples
