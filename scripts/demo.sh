@@ -6,7 +6,7 @@
 # episode). Choose another episode with TASK, SETTING, INDEX, SEED. Output in build/demo/.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-task=${TASK:-COLL} setting=${SETTING:-clean} index=${INDEX:-3} seed=${SEED:-0}
+task=${TASK:-ALN} setting=${SETTING:-clean} index=${INDEX:-1} seed=${SEED:-0}
 bash "$root/scripts/install_deps.sh"
 cmake -S "$root" -B "$root/build/release" -DCMAKE_BUILD_TYPE=Release -DMANISOFT_BUILD_TESTS=OFF -DMANISOFT_BUILD_BENCHMARKS=OFF
 cmake --build "$root/build/release" --target run_task render_scene -j2

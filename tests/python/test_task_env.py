@@ -53,8 +53,8 @@ class TaskEnvTest(unittest.TestCase):
         self.assertGreater(len(np.unique(obs["image"].reshape(-1, 3), axis=0)), 50)
 
     def test_expert_finishes_a_fixed_scene(self):
-        env = manisoft.make_env("COLL", "clean", seed=0)
-        obs, info = env.reset(options={"index": 3})
+        env = manisoft.make_env("ALN", "clean", seed=0)
+        obs, info = env.reset(options={"index": 1})
         rewards = []
         for _ in range(env.horizon):
             obs, reward, terminated, truncated, info = env.step(env.expert_action())
