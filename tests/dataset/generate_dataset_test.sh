@@ -62,7 +62,8 @@ for k in range(6):
 PY
 
 # robomimic-style reading with h5py alone
-"$python" "$reader" "$work/one" | grep -q "demos 6 "
+summary=$("$python" "$reader" "$work/one")  # not piped into grep -q: an early exit would break the reader's pipe
+grep -q "demos 6 " <<< "$summary" || { echo "FAIL: read_dataset.py: $summary"; exit 1; }
 
 # the paper's figure 4 plots and table, and Diffusion Policy's zarr layout
 "$python" "$examples/dataset_stats.py" "$work/one" --out "$work/stats" > /dev/null
