@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "../render/spec_render_scene.hpp"
 #include "manisoft/dataset/episode.hpp"
@@ -59,18 +60,11 @@ class EpisodeImages {
 
   void add_image(const manisoft::task::TaskEnv& env, manisoft::dataset::ImageSequence& images, long step) {
     const auto& w = env.world();
-    manisoft::render::FrameState frame = scene_.frame;
-    frame.rod.nodes = w.rod().state().positions;
-    frame.rod.directors.resize(0, 9);
     const manisoft::math::Pose<double> gripper{w.rigid().orientation(w.gripper_body()).toRotationMatrix(), w.rigid().position(w.gripper_body())};
-    manisoft::render::tabletop::set_gripper(scene_, frame, gripper, w.gripper().finger_width());
-    const auto& objects = env.bodies().objects;
-    for (std::size_t i = 0; i < scene_.scene.instances.size(); ++i) {
-      const std::string& name = scene_.scene.instances[i].name;
-      if (name.rfind("object", 0) != 0) continue;
-      const std::size_t k = std::stoul(name.substr(6, name.find(' ') - 6));
-      frame.instance_poses[i] = {w.rigid().orientation(objects[k]).toRotationMatrix(), w.rigid().position(objects[k])};
-    }
+    objects_.clear();
+    for (const auto b : env.bodies().objects) objects_.push_back({w.rigid().orientation(b).toRotationMatrix(), w.rigid().position(b)});
+    const manisoft::render::FrameState frame =
+        manisoft::render::spec::task_frame(scene_, w.rod().state().positions, gripper, w.gripper().finger_width(), objects_);
     gl_->render_into(frame, out_);
     images.pixels.insert(images.pixels.end(), out_.rgb.begin(), out_.rgb.end());
     images.steps.push_back(step);
@@ -82,6 +76,7 @@ class EpisodeImages {
   std::unique_ptr<manisoft::render::GlRenderer> gl_;
   manisoft::render::tabletop::TabletopScene scene_;
   manisoft::render::RenderOutput out_;
+  std::vector<manisoft::math::Pose<double>> objects_;
 };
 
 }  // namespace manisoft_examples

@@ -100,24 +100,13 @@ class SceneRenderer {
                 ms::render::GlRenderer& gl)
       : scene_(ms::render::spec::make_spec_scene(spec, library)), gl_(&gl) {
     if (camera) scene_.scene.cameras = {*camera};
-    for (std::size_t i = 0; i < spec.objects.size(); ++i) object_names_.push_back("object" + std::to_string(i));
     gl_->set_scene(scene_.scene);
   }
 
   /// The frame of a state: rod centreline, gripper body pose and opening, object poses.
   void set_state(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3>>& rod_nodes, const ms::math::Pose<double>& gripper,
                  double finger_width, const std::vector<ms::math::Pose<double>>& objects) {
-    frame_ = scene_.frame;
-    frame_.rod.nodes = rod_nodes;
-    frame_.rod.directors.resize(0, 9);
-    ms::render::tabletop::set_gripper(scene_, frame_, gripper, finger_width);
-    for (std::size_t i = 0; i < scene_.scene.instances.size(); ++i) {
-      const std::string& n = scene_.scene.instances[i].name;
-      const std::string name = n.substr(0, n.find(' '));
-      if (name.rfind("object", 0) != 0) continue;
-      const std::size_t k = std::stoul(name.substr(6));
-      if (k < objects.size()) frame_.instance_poses[i] = objects[k];
-    }
+    frame_ = ms::render::spec::task_frame(scene_, rod_nodes, gripper, finger_width, objects);
   }
 
   /// Renders the current frame (the GIL released); the image as a numpy array.
@@ -135,7 +124,6 @@ class SceneRenderer {
   ms::render::GlRenderer* gl_;
   ms::render::FrameState frame_;
   ms::render::RenderOutput out_;
-  std::vector<std::string> object_names_;
 };
 
 /// A GlRenderer for the image a policy sees: shadows on, only colour read back.

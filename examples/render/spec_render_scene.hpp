@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/scene/scene_spec.hpp"
@@ -86,6 +87,24 @@ inline tabletop::TabletopScene make_spec_scene(const scene::SceneSpec& s, const 
   f.rod = tabletop::arc_rod(s.arm_mount.base_position, 1.0, 20, 35.0 * 3.14159265358979323846 / 180.0, 0.05);
   tabletop::set_gripper(t, f, tabletop::gripper_at_tip(f.rod), 0.10);
   return t;
+}
+
+/// The frame of a task state in a make_spec_scene scene: the rod's centreline, the gripper body's
+/// pose and finger opening, and object i's pose (asset frame -> world) for every part named
+/// "object<i> ...".
+inline FrameState task_frame(const tabletop::TabletopScene& t, const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3>>& rod_nodes,
+                             const math::Pose<double>& gripper, double finger_width, const std::vector<math::Pose<double>>& objects) {
+  FrameState f = t.frame;
+  f.rod.nodes = rod_nodes;
+  f.rod.directors.resize(0, 9);
+  tabletop::set_gripper(t, f, gripper, finger_width);
+  for (std::size_t i = 0; i < t.scene.instances.size(); ++i) {
+    const std::string& name = t.scene.instances[i].name;
+    if (name.rfind("object", 0) != 0) continue;
+    const std::size_t k = std::stoul(name.substr(6, name.find(' ') - 6));
+    if (k < objects.size()) f.instance_poses[i] = objects[k];
+  }
+  return f;
 }
 
 }  // namespace manisoft::render::spec
