@@ -50,6 +50,12 @@ int main(int argc, char** argv) {
   app.add_option("--start-error", expert_config.start_error, "expert: a chained path starts once the previous one is this near its end, m")->check(CLI::PositiveNumber);
   app.add_option("--place-clearance", expert_config.place_clearance, "expert: the object's bottom above its support when released, m")->check(CLI::NonNegativeNumber);
   app.add_option("--approach-distance", expert_config.approach_distance, "expert: approach pose distance from the grasp, m")->check(CLI::PositiveNumber);
+  app.add_option("--settle-error", expert_config.settle_error, "expert: close / open once the end-effector is this near its pose, m")->check(CLI::PositiveNumber);
+  app.add_option("--release-lift", expert_config.release_lift, "expert: a tall object is held this far above where its support took it before the release, m")->check(CLI::NonNegativeNumber);
+  app.add_option("--contact-depth", expert_config.contact_depth, "expert: a tall object's lower line ends this far below its support, m")->check(CLI::NonNegativeNumber);
+  app.add_option("--retract-speed", expert_config.retract_peak_speed, "expert: peak end-effector speed of the retract after a release, m/s")->check(CLI::PositiveNumber);
+  app.add_option("--release-settle-speed", expert_config.release_settle_speed, "expert: a tall object is let go once the arm's tip is slower, m/s")->check(CLI::NonNegativeNumber);
+  app.add_option("--lower-speed", expert_config.lower_peak_speed, "expert: peak end-effector speed of the lower line, m/s")->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   try {
     const std::clock_t c0 = std::clock();

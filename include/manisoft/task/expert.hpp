@@ -21,13 +21,17 @@
 // Waypoints of a move (the end-effector frame; straight lines with quintic timing, or a cruise
 // at constant speed over path_cruise of the line: ModelExecutor::track_line): approach (along
 // the annotation's approach direction, approach_distance from the grasp; "via": first level to
-// above it), grasp, close once settled
+// above it, for a tall object high enough that the fingertips pass approach_tip_clearance above
+// its top; candidates whose approach would sweep the open fingers into a tall object come last:
+// approach_clear()), grasp, close once settled
 // (the arm's tip slower than settle_speed), carry (above the place pose, diagonal from the grasp;
 // "via": first straight up by lift_height), place (corrected for where the object sits in the
-// hand, measured when it is held; lowered once the arm's tip is slower than carry_settle_speed),
-// open once settled or as soon as the support carries the object (a tall one: the arm stops
-// there, release_lift up, and opens once its tip is slower than release_settle_speed), then up
-// until the fingertips clear the object's top (after the last move too). A
+// hand, measured when it is held; lowered at lower_peak_speed once the arm's tip is slower than
+// carry_settle_speed), open once settled or as soon as the support carries the object (a tall
+// one, height above tall_ratio x width, is lowered on until its support carries it, contact_depth
+// below, so it is not dropped onto its rim; the arm stops there, release_lift up, and opens once
+// its tip is slower than release_settle_speed), then up at retract_peak_speed until the
+// fingertips clear the object's top (after the last move too). A
 // leg whose straight line would pass towards the inner edge of the arm's reach (arc_inset nearer
 // its base than its farther end) goes round an arc point about the base instead. A missed grasp
 // re-opens and retries the move from its approach (max_retries).
@@ -74,12 +78,16 @@ struct ExpertConfig {
   double carry_node_speed = 0.9;    ///< m/s
   double path_cruise = 0.5;         ///< fraction of a path at constant speed (0: quintic timing; ModelExecutor::track_line)
   int min_segment_steps = 60;       ///< shortest path, control steps
-  double settle_speed = 0.05;       ///< m/s: close / open only when the arm's tip is slower
+  double settle_speed = 0.15;       ///< m/s: close / open only when the arm's tip is slower
   double settle_error = 0.01;       ///< m: and the end-effector this near its pose
   int max_settle_steps = 200;       ///< longest wait for settling (then act anyway)
   double release_settle_speed = 0.05;  ///< m/s: once the support carries a tall object, stop and open only when the arm's tip is slower (0: open at once)
   double tall_ratio = 1.2;          ///< an object is tall (release_settle_speed) above this height / width
-  double release_lift = 0.005;      ///< m: the stop above where the arm is (release_settle_speed)
+  double release_lift = 0.0;        ///< m: the stop above where the arm is (release_settle_speed)
+  double contact_depth = 0.004;     ///< m: a tall object is lowered until its support carries it: its lower line ends this far below its support
+  double retract_peak_speed = 0.9;  ///< m/s: peak end-effector speed of the retract after a release
+  double lower_peak_speed = 0.3;    ///< m/s: peak end-effector speed of the lower line
+  double approach_tip_clearance = 0.02;  ///< m: a tall object's approach keeps the open fingertips this far above its top until they straddle it
   double carry_settle_speed = 0.1;  ///< m/s: lower only once the arm's tip is slower at the end of the carry (0: at once)
   double start_error = 0.015;       ///< m: a chained path starts once the previous one is this near
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
@@ -182,6 +190,7 @@ class Expert {
     Pose object_target;  ///< asset frame -> world at release
     Pose grasp, place;   ///< end-effector poses
     bool via_approach = false, via_carry = false;
+    Pose start;  ///< the end-effector pose the approach leg starts from
     Leg approach_leg, carry_leg;
   };
 
@@ -213,18 +222,59 @@ class Expert {
     return a;
   }
 
+  /// Height (world z) of the open fingertips at end-effector pose `p`.
+  double tips_z(const Pose& p) const {
+    const auto& gp = env_->gripper_parameters();
+    return p.act(Vec3(0, 0, gp.palm_thickness + gp.finger_length)).z();
+  }
+  /// Height (world z) of object i's top as it stands now.
+  double top_of(int object) const { return state_of(object).pose.act(Vec3(0, 0, scene::asset_height(asset_of(object)))).z(); }
+
   /// The approach leg from the end-effector pose `from` (the annotation's approach pose last).
+  /// "via": level to above the approach pose first, for a tall object (is_tall()) high enough
+  /// that the fingertips pass approach_tip_clearance above its top, then straight down.
   void set_approach_leg(Plan& p, const Pose& approach, const Pose& from) const {
     p.approach_leg.clear();
+    p.start = from;
     Pose prev = from;
     if (p.via_approach) {
       Pose above = approach;
       above.translation.z() = std::max(approach.translation.z(), from.translation.z());
+      if (is_tall(p.object))
+        above.translation.z() = std::max(above.translation.z(), approach.translation.z() + top_of(p.object) + config_.approach_tip_clearance - tips_z(approach));
       append_leg(p.approach_leg, prev, above);
       prev = above;
     }
     append_leg(p.approach_leg, prev, approach);
   }
+  /// Whether the approach leg keeps the open fingers off a tall object (is_tall(); a low one
+  /// does not tip over): sampled along each line (positions linear, the line's end orientation),
+  /// wherever the fingertips are lower than approach_tip_clearance above its top, the gripper's
+  /// axis is either over it (it is between the fingers whichever way they turn) or out of the
+  /// fingers' reach of it.
+  bool approach_clear(const Plan& p) const {
+    if (!is_tall(p.object)) return true;
+    const auto& gp = env_->gripper_parameters();
+    const double r = scene::footprint_radius(asset_of(p.object)), top = top_of(p.object);
+    const Eigen::Vector2d axis = state_of(p.object).pose.translation.head<2>();
+    const double between = 0.5 * gp.open_width - r;
+    const double reach = r + std::hypot(0.5 * gp.open_width + gp.finger_thickness, gp.finger_half_width);
+    constexpr int samples = 16;
+    Pose prev = p.start;
+    for (int i = 0; i < p.approach_leg.count; ++i) {
+      const Pose& to = p.approach_leg.pose[static_cast<std::size_t>(i)];
+      for (int k = 1; k <= samples; ++k) {
+        Pose x = to;
+        x.translation = prev.translation + (double(k) / samples) * (to.translation - prev.translation);
+        const Vec3 tips = x.act(Vec3(0, 0, gp.palm_thickness + gp.finger_length));
+        const double d = (tips.head<2>() - axis).norm();
+        if (tips.z() < top + config_.approach_tip_clearance && d > between && d < reach) return false;
+      }
+      prev = to;
+    }
+    return true;
+  }
+
   /// The carry leg from the grasp to carry_height above the place pose.
   void set_carry_leg(Plan& p) const {
     Pose above = p.place;
@@ -359,7 +409,8 @@ class Expert {
             set_approach_leg(p, now * about_axis * approach_pose(g) * half, from);
             set_carry_leg(p);
             // least turning first, then the fewest lines
-            const double cost = std::max(turn_from_home(p.grasp), turn_from_home(p.place)) + 1e-3 * variant;
+            // (approaches that would sweep the fingers into a tall object last)
+            const double cost = std::max(turn_from_home(p.grasp), turn_from_home(p.place)) + 1e-3 * variant + (approach_clear(p) ? 0.0 : 10.0);
             candidates.push_back({cost, p});
           }
         }
@@ -470,11 +521,11 @@ class Expert {
   }
 
   /// Starts the path to `goal`; a refused one ends the episode's plan (give_up) when `required`.
-  bool start_path(const Pose& goal, bool required = true) {
+  bool start_path(const Pose& goal, bool required = true, double peak_speed = 0) {
     const double distance = (goal.translation - executor_.statics().desired_tip_pose().translation).norm();
     const double control_dt = env_->control_dt();
     const bool loaded = s_ == 1;
-    const double peak = loaded ? config_.carry_peak_speed : config_.path_peak_speed;
+    const double peak = peak_speed > 0 ? peak_speed : loaded ? config_.carry_peak_speed : config_.path_peak_speed;
     const double node = loaded ? config_.carry_node_speed : config_.max_node_speed;
     // peak speed / mean speed of the timing
     const double peak_ratio = config_.path_cruise > 0 ? 2 / (1 + config_.path_cruise) : 1.875;
@@ -511,12 +562,21 @@ class Expert {
     if (!start_ramp(leg.pose[k])) give_up("a ramp target has no inverse statics solution within the actuation limits");
   }
 
-  /// Whether the held object is let go only once the arm is still (release_settle_speed): a
-  /// tall one (height above tall_ratio x its width).
-  bool release_settles() const {
-    if (!(config_.release_settle_speed > 0)) return false;
-    const auto& a = asset_of(plan_.object);
+  /// Whether object i is tall: its height above tall_ratio x its width.
+  bool is_tall(int object) const {
+    const auto& a = asset_of(object);
     return scene::asset_height(a) > config_.tall_ratio * 2 * std::max(a.bounding_half_extents.x(), a.bounding_half_extents.y());
+  }
+  /// Whether the held object is let go only once the arm is still (release_settle_speed): a
+  /// tall one.
+  bool release_settles() const { return config_.release_settle_speed > 0 && is_tall(plan_.object); }
+
+  /// The end of the lower line: the place pose; for a tall object (release_settles()) lowered
+  /// on by place_clearance + contact_depth, so that it reaches its support and is not dropped.
+  Pose lower_goal() const {
+    Pose p = plan_.place;
+    if (release_settles() && config_.contact_depth > 0) p.translation.z() -= config_.place_clearance + config_.contact_depth;
+    return p;
   }
 
   /// Whether something under the held object carries it (see the lower phase).
@@ -605,7 +665,7 @@ class Expert {
           } else if (!(config_.carry_settle_speed > 0) || speed < config_.carry_settle_speed || ++waited_ > config_.max_settle_steps) {
             waited_ = 0;
             enter(ExpertPhase::lower);
-            start_path(plan_.place);
+            start_path(lower_goal(), true, config_.lower_peak_speed);
           }
         }
         break;
@@ -644,7 +704,7 @@ class Expert {
         retries_ = 0;
         enter(ExpertPhase::retract);
         // a refused retract is not a failure: the next move plans from here, or the arm holds
-        if (!start_path(retract_pose(), false)) {
+        if (!start_path(retract_pose(), false, config_.retract_peak_speed)) {
           if (move_ < moves_) begin_move();
           else enter(ExpertPhase::idle);
         }
