@@ -75,6 +75,13 @@ struct SamplerSettings {
   geometry::RelationTolerances relations;  ///< ARR: the success predicate's margins
   double relation_margin = 0.02;    ///< m: the ARR spot holds with margins this much tighter, the start fails with them this much wider
   int min_obstacles = 3, max_obstacles = 10;
+  /// The open gripper at the arm's home pose (task::TaskEnvConfig::home: grasp centre above
+  /// (0.50, 0), fingertips 0.095 m above the table top): an object or obstacle taller than
+  /// home_clear_height keeps its footprint home_keepout (the gripper's half diagonal and a margin)
+  /// from home_xy, so the fingers do not start in it.
+  Eigen::Vector2d home_xy{0.50, 0.0};
+  double home_clear_height = 0.09;  ///< m above the table top
+  double home_keepout = 0.09;       ///< m
   ReachBand band;
   ValidationSettings validation;
 };
@@ -174,16 +181,22 @@ class SceneSampler {
       if (static_cast<int>(i) != ignore && (discs_[i].c - p).norm() < discs_[i].r + r + settings_.gap) return false;
     return true;
   }
+  /// Whether a footprint of radius r at p for something `height` tall leaves the home gripper free
+  /// (SamplerSettings::home_keepout).
+  bool clear_of_home(const Eigen::Vector2d& p, double r, double height) const {
+    return height <= settings_.home_clear_height || (p - settings_.home_xy).norm() >= r + settings_.home_keepout;
+  }
   /// A free point of the reachable area (ReachBand) at grasp height h for a footprint of radius
-  /// r: uniform over the table, kept when inside the band (rejection sampling).
-  std::optional<Eigen::Vector2d> reachable_spot(const SceneSpec& s, Draw& d, double h, double r) {
+  /// r of something `height` tall (clear_of_home): uniform over the table, kept when inside the band
+  /// (rejection sampling).
+  std::optional<Eigen::Vector2d> reachable_spot(const SceneSpec& s, Draw& d, double h, double r, double height = 0) {
     const auto& b = settings_.band;
     const Eigen::Vector2d c = s.table.top_center.head<2>();
     for (int t = 0; t < settings_.placement_tries; ++t) {
       const double px = d.uniform(c.x() - s.table.half_x, c.x() + s.table.half_x);  // one draw per statement: the
       const double py = d.uniform(c.y() - s.table.half_y, c.y() + s.table.half_y);  // order of arguments is unspecified
       const Eigen::Vector2d p(px, py);
-      if (b.contains(p, h) && on_table(s, p, r) && free(p, r)) return p;
+      if (b.contains(p, h) && on_table(s, p, r) && free(p, r) && clear_of_home(p, r, height)) return p;
     }
     return std::nullopt;
   }
@@ -201,7 +214,7 @@ class SceneSampler {
   /// Places asset `a` in the reachable band at height h; returns its object index or -1.
   int place_object(SceneSpec& s, Draw& d, const assets::Asset& a, double h, bool grasped) {
     const double r = keepout(a, grasped);
-    const auto p = reachable_spot(s, d, h, r);
+    const auto p = reachable_spot(s, d, h, r, asset_height(a));
     if (!p) return -1;
     PlacedAsset o;
     o.asset_id = a.id;
@@ -252,7 +265,7 @@ class SceneSampler {
         const double px = d.uniform(s.table.top_center.x() - s.table.half_x, s.table.top_center.x() + s.table.half_x);
         const double py = d.uniform(s.table.top_center.y() - s.table.half_y, s.table.top_center.y() + s.table.half_y);
         const Eigen::Vector2d p(px, py);
-        if (!on_table(s, p, r) || !free(p, r)) continue;
+        if (!on_table(s, p, r) || !free(p, r) || !clear_of_home(p, r, asset_height(a))) continue;
         PlacedAsset o;
         o.asset_id = a.id;
         o.pose = upright(a, p, top, d.uniform(-3.14159265358979323846, 3.14159265358979323846));
@@ -265,16 +278,18 @@ class SceneSampler {
     return static_cast<int>(s.obstacles.size()) == n;
   }
 
-  /// Whether `obj` fits into `container` with `fit_clearance` to spare. Square openings (a
-  /// basket's straight walls): its larger side. Round ones (a bowl flares from its floor to the
-  /// rim): its footprint circle passes the rim (the outer radius less the clearance, which covers
-  /// the wall) and, standing on the floor, its centre of mass stays below the rim, inside the COLL
-  /// predicate's inner volume.
+  /// Whether `obj` fits into `container` with `fit_clearance` to spare: it passes the opening
+  /// and, standing on the floor, its centre of mass stays below the rim, inside the COLL
+  /// predicate's inner volume. Passing the opening: square ones (a basket's straight walls) its
+  /// larger side; round ones (a bowl flares from its floor to the rim) its footprint circle (the
+  /// outer radius less the clearance, which covers the wall). A category none of whose instances
+  /// fits any container (bottles, candle sticks, trophies, shoes) keeps all its instances
+  /// (draw_coll): its scenes cannot be solved.
   bool fits(const assets::Asset& obj, const assets::Asset& container) const {
     if (container.receptacles.empty()) return false;
     const auto& r = container.receptacles.front();
-    if (r.inner_radius > 0)
-      return footprint_radius(obj) <= container.bounding_half_extents.x() - settings_.fit_clearance && obj.center_of_mass.z() <= r.inner_depth;
+    if (obj.center_of_mass.z() > r.inner_depth) return false;
+    if (r.inner_radius > 0) return footprint_radius(obj) <= container.bounding_half_extents.x() - settings_.fit_clearance;
     return 2 * std::max(obj.bounding_half_extents.x(), obj.bounding_half_extents.y()) <= 2 * r.inner_half_extents.minCoeff() - settings_.fit_clearance;
   }
 
