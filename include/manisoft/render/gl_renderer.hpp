@@ -12,8 +12,12 @@
 // specialised at compile time (texture kind, light kind, shadows) and kept short; a directional
 // light's shadow map is rendered only over the shadow casters' extent (a sub-rectangle of the map
 // at the full map's texel size, so the shadows look the same as with the whole map); the shadow
-// pass culls back faces; the image is rendered upside down so that glReadPixels returns rows top
-// first (no flipping copies); the id target is drawn only when the mask is read.
+// pass culls back faces; receivers that cast no shadow (the floor) run the shadow lookup only in
+// the screen rectangle where the map's window can shadow them (the program without it elsewhere:
+// the same pixels); opaque meshes are drawn small before large, receivers last (early depth test);
+// the image is rendered upside down so that glReadPixels returns rows top first (no flipping
+// copies), and colour is read as RGBA (llvmpipe's copy path); the id target is drawn only when the
+// mask is read; glibc's heap trimming is relaxed (GlRendererOptions::keep_freed_heap).
 #pragma once
 
 #include <GL/glcorearb.h>
@@ -29,6 +33,9 @@
 #include <numbers>
 #include <string>
 #include <vector>
+#if defined(__GLIBC__)  // defined by the standard headers above
+#include <malloc.h>     // mallopt (GlRendererOptions::keep_freed_heap)
+#endif
 
 #include "manisoft/core/error.hpp"
 #include "manisoft/render/camera.hpp"
@@ -49,6 +56,13 @@ struct GlRendererOptions {
   int msaa_samples = 0;        ///< 0 or 1: none; 2, 4, 8: multisampling
   bool read_depth = true;      ///< fill RenderOutput::depth
   bool read_mask = true;       ///< fill RenderOutput::mask
+  /// glibc only: raise the process's heap trim threshold to 64 MiB (mallopt(M_TRIM_THRESHOLD),
+  /// process-wide, once per GlRenderer). Mesa frees and re-allocates its large per-draw vertex
+  /// buffers every frame; with glibc's default threshold the freed heap top is returned to the
+  /// system and faulted back in each frame (several brk calls a frame, each a TLB shoot-down
+  /// across CPUs; about 5% of a frame's CPU work on llvmpipe). The cost: up to 64 MiB of freed
+  /// memory stays with the process.
+  bool keep_freed_heap = true;
   EglOptions egl;
 };
 
@@ -378,6 +392,9 @@ class GlRenderer {
           options_.msaa_samples == 8)) {
       manisoft::detail::fail("GlRenderer msaa_samples = ", options_.msaa_samples, " is invalid: 0, 1, 2, 4 or 8");
     }
+#if defined(__GLIBC__)
+    if (options_.keep_freed_heap) mallopt(M_TRIM_THRESHOLD, 64 << 20);
+#endif
     context_ = std::make_unique<EglContext>(options_.egl);
     try {
       GLint major = 0;
@@ -413,7 +430,15 @@ class GlRenderer {
     context_->make_current();
     validate_scene(scene);
     const std::size_t light_set = scene.lighting.kind == LightKind::spot ? 1 : 0;
-    if (programs_[light_set][0] == 0) build_programs(light_set);
+    build_programs(light_set);
+    // Receivers (instances that cast no shadow, e.g. the floor) are drawn without the shadow
+    // lookup where they cannot be in shadow (render_into): their programs without shadows.
+    if (options_.shadows) {
+      for (const Instance& inst : scene.instances) {
+        const auto kind = static_cast<std::size_t>(scene.materials[static_cast<std::size_t>(inst.material)].texture);
+        if (!inst.casts_shadow) ensure_program(light_set, 0, kind);
+      }
+    }
     mesh_bounds_.clear();
     for (const Mesh& m : scene.meshes) {
       Eigen::AlignedBox3f box;
@@ -426,6 +451,18 @@ class GlRenderer {
     for (auto& g : triad_) detail_gl::destroy(g);
     const std::vector<Mesh> triad = make_axis_triad(scene.goal_marker.axis_length, scene.goal_marker.axis_width);
     for (std::size_t i = 0; i < 3; ++i) detail_gl::upload(triad_[i], triad[i], false, upload_scratch_);
+    // Draw order: shadow casters before receivers (the floor), each by increasing mesh bounding
+    // box volume, so that small objects are drawn before the table they stand on.
+    draw_order_.resize(scene.instances.size());
+    for (std::size_t i = 0; i < draw_order_.size(); ++i) draw_order_[i] = i;
+    auto volume = [&](std::size_t i) {
+      const Eigen::AlignedBox3f& box = mesh_bounds_[static_cast<std::size_t>(scene.instances[i].mesh)];
+      return box.isEmpty() ? 0.0f : box.volume();
+    };
+    std::stable_sort(draw_order_.begin(), draw_order_.end(), [&](std::size_t a, std::size_t b) {
+      const bool ca = scene.instances[a].casts_shadow, cb = scene.instances[b].casts_shadow;
+      return ca != cb ? ca : volume(a) < volume(b);
+    });
     scene_ = scene;
     have_scene_ = true;
   }
@@ -542,42 +579,65 @@ class GlRenderer {
     const float spot_cos = static_cast<float>(std::cos(light.spot_cone_deg * std::numbers::pi / 180.0));
     const float shadow_window[2] = {static_cast<float>(shadow.window_x), static_cast<float>(shadow.window_y)};
     light_set_ = light.kind == LightKind::spot ? 1 : 0;
-    for (std::size_t kind = 0; kind < texture_kinds; ++kind) {  // per-frame uniforms of every variant
-      const Uniforms& u = uniforms_[light_set_][kind];
-      glUseProgram(programs_[light_set_][kind]);
-      glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, view_projection.data());
-      glUniformMatrix4fv(u.light_view_projection, 1, GL_FALSE, shadow.view_projection.data());
-      glUniform3fv(u.light_direction, 1, light_direction.data());
-      glUniform3fv(u.light_position, 1, light_position.data());
-      glUniform1f(u.spot_cos, spot_cos);
-      glUniform3fv(u.light_color, 1, light_color.data());
-      glUniform3fv(u.ambient, 1, ambient.data());
-      glUniform3fv(u.camera_position, 1, eye.data());
-      glUniform1i(u.shadow_map, 0);
-      glUniform2fv(u.shadow_window, 1, shadow_window);
-      glUniform1f(u.shadow_size, static_cast<float>(options_.shadow_map_size));
-      glUniform1f(u.shadow_bias, shadow.bias);
+    for (std::size_t variant = 0; variant < 2; ++variant) {  // per-frame uniforms of every program
+      for (std::size_t kind = 0; kind < texture_kinds; ++kind) {
+        const GLuint program = programs_[light_set_][variant][kind];
+        if (program == 0) continue;
+        const Uniforms& u = uniforms_[light_set_][variant][kind];
+        glUseProgram(program);
+        glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, view_projection.data());
+        glUniformMatrix4fv(u.light_view_projection, 1, GL_FALSE, shadow.view_projection.data());
+        glUniform3fv(u.light_direction, 1, light_direction.data());
+        glUniform3fv(u.light_position, 1, light_position.data());
+        glUniform1f(u.spot_cos, spot_cos);
+        glUniform3fv(u.light_color, 1, light_color.data());
+        glUniform3fv(u.ambient, 1, ambient.data());
+        glUniform3fv(u.camera_position, 1, eye.data());
+        glUniform1i(u.shadow_map, 0);
+        glUniform2fv(u.shadow_window, 1, shadow_window);
+        glUniform1f(u.shadow_size, static_cast<float>(options_.shadow_map_size));
+        glUniform1f(u.shadow_bias, shadow.bias);
+      }
     }
-    current_ = texture_kinds - 1;
+    current_kind_ = texture_kinds;  // none: the next set_material binds its program
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, shadow_texture_);
 
-    // Rod first, then casters, then large receivers (floor): near-to-far helps early depth tests.
+    // Rod first, then the instances in draw_order_ (small before large, large receivers such as
+    // the floor last): occluders first lets llvmpipe's early depth test skip hidden blocks.
     if (draw_rod) {
-      set_material(scene_.materials[static_cast<std::size_t>(scene_.rod.material)]);
+      set_material(scene_.materials[static_cast<std::size_t>(scene_.rod.material)], true);
       set_model(math::Pose<double>{});
-      glUniform1ui(uniforms_[light_set_][current_].object_id, scene_.rod.object_id);
+      glUniform1ui(current_uniforms().object_id, scene_.rod.object_id);
       draw(rod_gpu_);
     }
-    for (int pass = 0; pass < 2; ++pass) {
-      for (std::size_t i = 0; i < scene_.instances.size(); ++i) {
-        const Instance& inst = scene_.instances[i];
-        if (inst.casts_shadow != (pass == 0)) continue;
-        set_material(scene_.materials[static_cast<std::size_t>(inst.material)]);
-        set_model(frame.instance_poses[i]);
-        glUniform1ui(uniforms_[light_set_][current_].object_id, inst.object_id);
-        draw(meshes_[static_cast<std::size_t>(inst.mesh)]);
+    auto draw_instance = [&](std::size_t i, bool shadowed) {
+      const Instance& inst = scene_.instances[i];
+      set_material(scene_.materials[static_cast<std::size_t>(inst.material)], shadowed);
+      set_model(frame.instance_poses[i]);
+      glUniform1ui(current_uniforms().object_id, inst.object_id);
+      draw(meshes_[static_cast<std::size_t>(inst.mesh)]);
+    };
+    for (const std::size_t i : draw_order_) {
+      if (scene_.instances[i].casts_shadow || !options_.shadows) {
+        draw_instance(i, true);
+        continue;
       }
+      // A receiver: the shadow lookup only inside the screen rectangle where it can be shadowed,
+      // the program without it on the rest of the image (the same pixels: outside the shadow
+      // map's window the lookup returns 1).
+      const PixelRect inside = shadowed_screen_rect(frame.instance_poses[i], mesh_bounds_[static_cast<std::size_t>(scene_.instances[i].mesh)],
+                                                    shadow, view_projection, camera.width, camera.height);
+      glEnable(GL_SCISSOR_TEST);
+      for (const PixelRect& r : complement(inside, camera.width, camera.height)) {
+        glScissor(r.x0, r.y0, r.x1 - r.x0, r.y1 - r.y0);
+        draw_instance(i, false);
+      }
+      if (!inside.empty()) {
+        glScissor(inside.x0, inside.y0, inside.x1 - inside.x0, inside.y1 - inside.y0);
+        draw_instance(i, true);
+      }
+      glDisable(GL_SCISSOR_TEST);
     }
     if (frame.goal_pose) {
       const std::array<Eigen::Vector3f, 3> colors = {Eigen::Vector3f(0.85f, 0.1f, 0.1f), Eigen::Vector3f(0.1f, 0.7f, 0.1f),
@@ -585,9 +645,9 @@ class GlRenderer {
       for (std::size_t a = 0; a < 3; ++a) {
         Material m;
         m.base_color = colors[a];
-        set_material(m);
+        set_material(m, true);
         set_model(*frame.goal_pose);
-        glUniform1ui(uniforms_[light_set_][current_].object_id, scene_.goal_marker.object_id);
+        glUniform1ui(current_uniforms().object_id, scene_.goal_marker.object_id);
         draw(triad_[a]);
       }
     }
@@ -614,9 +674,19 @@ class GlRenderer {
     out.width = w;
     out.height = h;
     out.camera = model;
+    // RGBA is llvmpipe's copy path (RGBA8 target); GL_RGB goes through Mesa's format conversion
+    // (about 8x slower): read RGBA and drop alpha here.
     out.rgb.resize(pixels * 3);
+    scratch_rgba_.resize(pixels);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, out.rgb.data());
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, scratch_rgba_.data());
+    const std::array<std::uint8_t, 4>* rgba = scratch_rgba_.data();
+    std::uint8_t* rgb = out.rgb.data();
+    for (std::size_t i = 0; i < pixels; ++i) {
+      rgb[3 * i] = rgba[i][0];
+      rgb[3 * i + 1] = rgba[i][1];
+      rgb[3 * i + 2] = rgba[i][2];
+    }
     if (options_.read_mask) {
       out.mask.resize(pixels);
       glReadBuffer(GL_COLOR_ATTACHMENT1);
@@ -656,22 +726,27 @@ class GlRenderer {
     GLint shadow_map, shadow_window, shadow_size, shadow_bias, object_id;
   };
 
-  // Compiles the main programs of one light kind (0 directional, 1 spot), one per texture kind.
+  // Compiles the main programs of one light kind (0 directional, 1 spot), one per texture kind,
+  // with shadows when the options ask for them.
   void build_programs(std::size_t light_set) {
-    for (std::size_t kind = 0; kind < texture_kinds; ++kind) {
-      const std::string source = std::string(gather_ ? "#version 400 core\n" : "#version 330 core\n") + "#define TEXTURE_KIND " +
-                                 std::to_string(kind) + "\n#define SHADOWS " + (options_.shadows ? "1" : "0") + "\n#define LIGHT_KIND " +
-                                 std::to_string(light_set) + "\n#define GATHER " + (gather_ ? "1" : "0") + "\n" + detail_gl::main_fragment_shader;
-      const GLuint program = detail_gl::link(detail_gl::main_vertex_shader, source);
-      programs_[light_set][kind] = program;
-      auto at = [program](const char* name) { return glGetUniformLocation(program, name); };
-      uniforms_[light_set][kind] = Uniforms{at("u_model"),           at("u_normal_matrix"),   at("u_view_projection"),  at("u_light_view_projection"),
-                                            at("u_base_color"),      at("u_secondary_color"), at("u_texture_scale"),    at("u_texture_strength"),
-                                            at("u_specular"),        at("u_shininess"),       at("u_light_direction"),  at("u_light_position"),
-                                            at("u_spot_cos"),        at("u_light_color"),     at("u_ambient"),          at("u_camera_position"),
-                                            at("u_shadow_map"),      at("u_shadow_window"),   at("u_shadow_size"),      at("u_shadow_bias"),
-                                            at("u_object_id")};
-    }
+    for (std::size_t kind = 0; kind < texture_kinds; ++kind) ensure_program(light_set, options_.shadows ? 1 : 0, kind);
+  }
+
+  // Compiles one main program variant unless it exists.
+  void ensure_program(std::size_t light_set, std::size_t shadowed, std::size_t kind) {
+    if (programs_[light_set][shadowed][kind] != 0) return;
+    const std::string source = std::string(gather_ ? "#version 400 core\n" : "#version 330 core\n") + "#define TEXTURE_KIND " +
+                               std::to_string(kind) + "\n#define SHADOWS " + std::to_string(shadowed) + "\n#define LIGHT_KIND " +
+                               std::to_string(light_set) + "\n#define GATHER " + (gather_ ? "1" : "0") + "\n" + detail_gl::main_fragment_shader;
+    const GLuint program = detail_gl::link(detail_gl::main_vertex_shader, source);
+    programs_[light_set][shadowed][kind] = program;
+    auto at = [program](const char* name) { return glGetUniformLocation(program, name); };
+    uniforms_[light_set][shadowed][kind] = Uniforms{at("u_model"),           at("u_normal_matrix"),   at("u_view_projection"),  at("u_light_view_projection"),
+                                                    at("u_base_color"),      at("u_secondary_color"), at("u_texture_scale"),    at("u_texture_strength"),
+                                                    at("u_specular"),        at("u_shininess"),       at("u_light_direction"),  at("u_light_position"),
+                                                    at("u_spot_cos"),        at("u_light_color"),     at("u_ambient"),          at("u_camera_position"),
+                                                    at("u_shadow_map"),      at("u_shadow_window"),   at("u_shadow_size"),      at("u_shadow_bias"),
+                                                    at("u_object_id")};
   }
 
   void validate_scene(const SceneDescription& scene) const {
@@ -717,7 +792,77 @@ class GlRenderer {
     Eigen::Matrix4f view_projection = Eigen::Matrix4f::Identity();
     int window_x = 1, window_y = 1;  ///< texels
     float bias = 0;                  ///< normalised light depth of one texel
+    /// Directional light: the light's view and the window's extent in it (x, y, metres); only
+    /// points inside it can be in shadow.
+    bool windowed = false;
+    Eigen::Matrix4f view = Eigen::Matrix4f::Identity();
+    Eigen::Vector2f window_min = Eigen::Vector2f::Zero(), window_max = Eigen::Vector2f::Zero();
   };
+
+  /// A rectangle of framebuffer pixels [x0, x1) x [y0, y1).
+  struct PixelRect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool empty() const { return x1 <= x0 || y1 <= y0; }
+  };
+
+  /// The image minus `inside`: up to four rectangles (bands below and above, then left and right).
+  static std::array<PixelRect, 4> complement(const PixelRect& inside, int width, int height) {
+    if (inside.empty()) return {PixelRect{0, 0, width, height}, PixelRect{}, PixelRect{}, PixelRect{}};
+    return {PixelRect{0, 0, width, inside.y0}, PixelRect{0, inside.y1, width, height}, PixelRect{0, inside.y0, inside.x0, inside.y1},
+            PixelRect{inside.x1, inside.y0, width, inside.y1}};
+  }
+
+  // The pixels where a receiver can be in shadow: its world bounding box clipped to the prism
+  // that the shadow map's window sweeps along the light (light-view x, y inside the window, one
+  // texel added), projected into the image, plus one pixel. The whole image when that cannot be
+  // bounded (spot light, part of the clipped box behind the camera); empty when the box misses
+  // the prism.
+  static PixelRect shadowed_screen_rect(const math::Pose<double>& pose, const Eigen::AlignedBox3f& body_box, const ShadowProjection& shadow,
+                                        const Eigen::Matrix4f& view_projection, int width, int height) {
+    const PixelRect whole{0, 0, width, height};
+    if (!shadow.windowed || body_box.isEmpty()) return whole;
+    const Eigen::Matrix4f model = pose.matrix().cast<float>();
+    Eigen::AlignedBox3f box;
+    for (int c = 0; c < 8; ++c) {
+      box.extend((model.topLeftCorner<3, 3>() * body_box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)) + model.topRightCorner<3, 1>()).eval());
+    }
+    // The box's faces as corner indices (bit 0: x max, bit 1: y max, bit 2: z max).
+    static constexpr std::array<std::array<int, 4>, 6> faces = {{{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}}};
+    const float margin = (shadow.window_max.x() - shadow.window_min.x()) / static_cast<float>(shadow.window_x);  // one texel
+    Eigen::AlignedBox2f pixels;
+    for (const auto& face : faces) {
+      // Sutherland-Hodgman against the prism's four planes: each adds at most one vertex.
+      std::array<Eigen::Vector3f, 8> polygon, clipped;
+      int n = 4;
+      for (int k = 0; k < 4; ++k) polygon[static_cast<std::size_t>(k)] = box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(face[static_cast<std::size_t>(k)]));
+      for (int plane = 0; plane < 4 && n > 0; ++plane) {
+        const int axis = plane / 2;
+        const float sign = plane % 2 == 0 ? 1.0f : -1.0f;  // inside: sign (light-view coordinate - bound) >= 0
+        const float bound = plane % 2 == 0 ? shadow.window_min[axis] - margin : shadow.window_max[axis] + margin;
+        auto distance = [&](const Eigen::Vector3f& p) { return sign * (shadow.view.row(axis).head<3>().dot(p) + shadow.view(axis, 3) - bound); };
+        int m = 0;
+        for (int k = 0; k < n; ++k) {
+          const Eigen::Vector3f& a = polygon[static_cast<std::size_t>(k)];
+          const Eigen::Vector3f& b = polygon[static_cast<std::size_t>((k + 1) % n)];
+          const float da = distance(a), db = distance(b);
+          if (da >= 0) clipped[static_cast<std::size_t>(m++)] = a;
+          if ((da >= 0) != (db >= 0)) clipped[static_cast<std::size_t>(m++)] = a + (b - a) * (da / (da - db));
+        }
+        polygon = clipped;
+        n = m;
+      }
+      for (int k = 0; k < n; ++k) {
+        const Eigen::Vector4f clip = view_projection * polygon[static_cast<std::size_t>(k)].homogeneous();
+        if (!(clip.w() > 1e-6f)) return whole;
+        pixels.extend(Eigen::Vector2f((clip.x() / clip.w() + 1.0f) * 0.5f * static_cast<float>(width),
+                                      (clip.y() / clip.w() + 1.0f) * 0.5f * static_cast<float>(height)));
+      }
+    }
+    if (pixels.isEmpty()) return PixelRect{};
+    auto clamp_to = [](float v, int hi) { return static_cast<int>(std::clamp(v, 0.0f, static_cast<float>(hi))); };
+    return PixelRect{clamp_to(std::floor(pixels.min().x()) - 1.0f, width), clamp_to(std::floor(pixels.min().y()) - 1.0f, height),
+                     clamp_to(std::ceil(pixels.max().x()) + 1.0f, width), clamp_to(std::ceil(pixels.max().y()) + 1.0f, height)};
+  }
 
   // A spot light: a perspective frustum over its cone, the whole map. A directional light: an
   // orthographic projection whose texels are those of the whole map spanning the shadow sphere
@@ -773,17 +918,26 @@ class GlRenderer {
     out.view_projection = projection.cast<float>() * view;
     out.window_x = k1[0] - k0[0];
     out.window_y = k1[1] - k0[1];
+    out.windowed = true;
+    out.view = view;
+    out.window_min = Eigen::Vector2f(static_cast<float>(-r + k0[0] * tau), static_cast<float>(-r + k0[1] * tau));
+    out.window_max = Eigen::Vector2f(static_cast<float>(-r + k1[0] * tau), static_cast<float>(-r + k1[1] * tau));
     return out;
   }
 
-  // Selects the program of the material's texture kind and sets the material's uniforms.
-  void set_material(const Material& m) {
+  const Uniforms& current_uniforms() const { return uniforms_[light_set_][current_shadowed_][current_kind_]; }
+
+  // Selects the program of the material's texture kind (with the shadow lookup or without) and
+  // sets the material's uniforms.
+  void set_material(const Material& m, bool shadowed) {
     const auto kind = static_cast<std::size_t>(m.texture);
-    if (kind != current_) {
-      glUseProgram(programs_[light_set_][kind]);
-      current_ = kind;
+    const std::size_t variant = shadowed && options_.shadows ? 1 : 0;
+    if (kind != current_kind_ || variant != current_shadowed_) {
+      glUseProgram(programs_[light_set_][variant][kind]);
+      current_kind_ = kind;
+      current_shadowed_ = variant;
     }
-    const Uniforms& u = uniforms_[light_set_][current_];
+    const Uniforms& u = current_uniforms();
     glUniform3fv(u.base_color, 1, m.base_color.data());
     glUniform3fv(u.secondary_color, 1, m.secondary_color.data());
     glUniform1f(u.texture_scale, m.texture_scale);
@@ -795,8 +949,8 @@ class GlRenderer {
   void set_model(const math::Pose<double>& pose) {
     const Eigen::Matrix4f m = pose.matrix().cast<float>();
     const Eigen::Matrix3f n = pose.rotation.cast<float>();  // orthonormal: the normal matrix is the rotation
-    glUniformMatrix4fv(uniforms_[light_set_][current_].model, 1, GL_FALSE, m.data());
-    glUniformMatrix3fv(uniforms_[light_set_][current_].normal_matrix, 1, GL_FALSE, n.data());
+    glUniformMatrix4fv(current_uniforms().model, 1, GL_FALSE, m.data());
+    glUniformMatrix3fv(current_uniforms().normal_matrix, 1, GL_FALSE, n.data());
   }
 
   static void draw(const detail_gl::GpuMesh& g) {
@@ -874,10 +1028,12 @@ class GlRenderer {
     destroy_targets();
     if (shadow_fbo_) glDeleteFramebuffers(1, &shadow_fbo_);
     if (shadow_texture_) glDeleteTextures(1, &shadow_texture_);
-    for (auto& set : programs_) {
-      for (GLuint& p : set) {
-        if (p) glDeleteProgram(p);
-        p = 0;
+    for (auto& light_set : programs_) {
+      for (auto& set : light_set) {
+        for (GLuint& p : set) {
+          if (p) glDeleteProgram(p);
+          p = 0;
+        }
       }
     }
     if (shadow_program_) glDeleteProgram(shadow_program_);
@@ -891,14 +1047,16 @@ class GlRenderer {
   bool have_scene_ = false;
   static constexpr std::size_t texture_kinds = 6;  // TextureKind none..noise
   bool gather_ = false;                            // GLSL 4.00: textureGather for the shadow tap
-  std::array<std::array<GLuint, texture_kinds>, 2> programs_{};  // [light kind][texture kind]
-  std::array<std::array<Uniforms, texture_kinds>, 2> uniforms_{};
-  std::size_t light_set_ = 0;  // light kind of the frame being drawn
-  std::size_t current_ = 0;    // program in use (texture kind)
+  std::array<std::array<std::array<GLuint, texture_kinds>, 2>, 2> programs_{};  // [light kind][shadow lookup][texture kind]
+  std::array<std::array<std::array<Uniforms, texture_kinds>, 2>, 2> uniforms_{};
+  std::size_t light_set_ = 0;                       // light kind of the frame being drawn
+  std::size_t current_kind_ = 0;                    // program in use: texture kind
+  std::size_t current_shadowed_ = 0;                // and shadow variant
   GLuint shadow_program_ = 0;
   GLint u_shadow_model_ = -1, u_shadow_light_vp_ = -1;
   std::vector<detail_gl::GpuMesh> meshes_;
   std::vector<Eigen::AlignedBox3f> mesh_bounds_;  // body frame
+  std::vector<std::size_t> draw_order_;           // instance indices in main-pass order
   std::array<detail_gl::GpuMesh, 3> triad_{};
   detail_gl::GpuMesh rod_gpu_;
   Mesh rod_mesh_;
@@ -907,6 +1065,7 @@ class GlRenderer {
   std::array<GLuint, 3> main_rbs_{0, 0, 0}, resolve_rbs_{0, 0, 0};
   int target_width_ = 0, target_height_ = 0;
   std::vector<std::uint32_t> scratch_depth_;
+  std::vector<std::array<std::uint8_t, 4>> scratch_rgba_;
   std::vector<float> upload_scratch_;
 };
 
