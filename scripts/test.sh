@@ -4,8 +4,11 @@
 #      default -O3 build), -Wall -Wextra -Wpedantic -Werror; examples and benchmarks are built too.
 #      The per-header compile check runs in the clang build only (it parses twice as fast).
 #   2. clang++ with AddressSanitizer + UndefinedBehaviorSanitizer (-O1, line tables only: stack
-#      traces name file and line, and the build is faster than with full -g), tests and the examples the
-#      command-line tests run (no benchmarks).
+#      traces name file and line, and the build is faster than with full -g): the tests and the
+#      examples they run; the other examples and the per-header check compile at -O0 without
+#      sanitizers, for warnings only (no benchmarks).
+# Tests that instantiate the same templates share an executable built as one unity translation
+# unit (tests/CMakeLists.txt): the world or the executor is compiled once per group, not per file.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 jobs=${JOBS:-2}

@@ -1,14 +1,19 @@
 // Camera images of a recorded episode, rendered while its actions replay in a TaskEnv (the replay
 // is exact, so the images are those of the original run): generate_dataset (--images every:K)
 // and render_dataset ("physics first, images later") share it. OpenGL through EGL
-// (render::GlRenderer, colour only), the scene drawn as examples/render/spec_render_scene.hpp does.
+// (render::GlRenderer, colour only) or Blender (one headless process per episode, rendering all
+// of its frames: examples/render/blender_run.hpp), the scene drawn as
+// examples/render/spec_render_scene.hpp does.
 #pragma once
 
+#include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "../render/blender_run.hpp"
 #include "../render/spec_render_scene.hpp"
 #include "manisoft/dataset/episode.hpp"
 #include "manisoft/render/gl_renderer.hpp"
@@ -19,9 +24,11 @@ namespace manisoft_examples {
 class EpisodeImages {
  public:
   /// `camera`: the view (its width and height are the images'); unset: each scene's own camera
-  /// at width x height.
-  EpisodeImages(int width, int height, std::optional<manisoft::render::Camera> camera = std::nullopt)
-      : width_(width), height_(height), camera_(camera) {}
+  /// at width x height. `blender`: render with Blender instead of OpenGL, in `blender_dir`
+  /// (scratch: the exported scene and the PNG frames of the episode being rendered).
+  EpisodeImages(int width, int height, std::optional<manisoft::render::Camera> camera = std::nullopt,
+                std::optional<manisoft::render::blender::RunOptions> blender = std::nullopt, std::filesystem::path blender_dir = {})
+      : width_(width), height_(height), camera_(camera), blender_(blender), blender_dir_(std::move(blender_dir)) {}
 
   /// Replays `e` (actions) from `spec` in `env`, an image every `every` control steps from step 0.
   manisoft::dataset::ImageSequence render(manisoft::task::TaskEnv& env, const manisoft::scene::SceneSpec& spec, const manisoft::dataset::Episode& e,
@@ -33,18 +40,20 @@ class EpisodeImages {
     env.reset(spec);
     const int n = static_cast<int>(e.actions.cols() - 1) / 3;
     manisoft::task::TaskEnv::Array3 torques(n, 3);
+    frames_.clear();
     for (long r = 0; r < e.steps(); ++r) {
       if (r % every == 0) add_image(env, images, r);
       for (int j = 0; j < n; ++j)
         for (int c = 0; c < 3; ++c) torques(j, c) = e.actions(r, 3 * j + c);
       env.step(torques, static_cast<int>(e.actions(r, 3 * n)));
     }
+    if (blender_) render_with_blender(images);
     return images;
   }
 
  private:
   void set_scene(const manisoft::scene::SceneSpec& spec, const manisoft::scene::AssetLibrary& library) {
-    if (!gl_) {
+    if (!gl_ && !blender_) {
       manisoft::render::GlRendererOptions o;
       o.read_depth = false;
       o.read_mask = false;
@@ -55,7 +64,7 @@ class EpisodeImages {
     camera.width = width_;
     camera.height = height_;
     scene_.scene.cameras = {camera};
-    gl_->set_scene(scene_.scene);
+    if (gl_) gl_->set_scene(scene_.scene);
   }
 
   void add_image(const manisoft::task::TaskEnv& env, manisoft::dataset::ImageSequence& images, long step) {
@@ -65,14 +74,35 @@ class EpisodeImages {
     for (const auto b : env.bodies().objects) objects_.push_back({w.rigid().orientation(b).toRotationMatrix(), w.rigid().position(b)});
     const manisoft::render::FrameState frame =
         manisoft::render::spec::task_frame(scene_, w.rod().state().positions, gripper, w.gripper().finger_width(), objects_);
-    gl_->render_into(frame, out_);
-    images.pixels.insert(images.pixels.end(), out_.rgb.begin(), out_.rgb.end());
     images.steps.push_back(step);
     ++images.frames;
+    if (blender_) {
+      frames_.push_back(frame);
+      return;
+    }
+    gl_->render_into(frame, out_);
+    images.pixels.insert(images.pixels.end(), out_.rgb.begin(), out_.rgb.end());
+  }
+
+  // All frames of the episode in one Blender process, then their PNGs into `images`.
+  void render_with_blender(manisoft::dataset::ImageSequence& images) {
+    std::filesystem::remove_all(blender_dir_);
+    manisoft::render::blender::render_frames(scene_.scene, frames_, blender_dir_, *blender_);
+    for (std::size_t k = 0; k < frames_.size(); ++k) {
+      char name[32];
+      std::snprintf(name, sizeof name, "rgb_%05zu.png", k);
+      const manisoft::render::RgbImage rgb = manisoft::render::read_png_rgb(blender_dir_ / name);
+      if (rgb.width != width_ || rgb.height != height_)
+        manisoft::detail::fail("blender frame ", (blender_dir_ / name).string(), " is ", rgb.width, " x ", rgb.height, ", expected ", width_, " x ", height_);
+      images.pixels.insert(images.pixels.end(), rgb.rgb.begin(), rgb.rgb.end());
+    }
   }
 
   int width_, height_;
   std::optional<manisoft::render::Camera> camera_;
+  std::optional<manisoft::render::blender::RunOptions> blender_;
+  std::filesystem::path blender_dir_;
+  std::vector<manisoft::render::FrameState> frames_;  // Blender: the episode's frames, rendered at its end
   std::unique_ptr<manisoft::render::GlRenderer> gl_;
   manisoft::render::tabletop::TabletopScene scene_;
   manisoft::render::RenderOutput out_;

@@ -27,6 +27,8 @@
 #include "manisoft/rod/inverse_statics.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
 
+namespace test_asset_grasps {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 using Eigen::Vector3d;
@@ -259,3 +261,5 @@ TEST_CASE("every container holds a small cube dropped into it", "[assets][recept
   }
   CHECK(containers >= 6 * 7);
 }
+
+}  // namespace test_asset_grasps

@@ -13,6 +13,8 @@
 #include "manisoft/assets/asset_view.hpp"
 #include "manisoft/assets/catalog.hpp"
 
+namespace test_assets {  // per-file namespace: the group's tests build as one unity translation unit
+
 using namespace manisoft;
 using namespace manisoft::assets;
 
@@ -204,3 +206,5 @@ TEST_CASE("asset views frame the whole bounding box", "[assets]") {
   flat.bounding_half_extents.setZero();
   CHECK_THROWS_AS(frame_asset(flat, opt), manisoft::Error);
 }
+
+}  // namespace test_assets

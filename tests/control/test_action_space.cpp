@@ -11,6 +11,8 @@
 #include "manisoft/control/action_space.hpp"
 #include "manisoft/rod.hpp"
 
+namespace test_action_space {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 namespace control = manisoft::control;
@@ -138,3 +140,5 @@ TEST_CASE("a B-spline muscle action bends a weightless rod until B kappa equals 
     CHECK(std::abs(ws.kappa(k - 1, 0)) < 1e-9);
   }
 }
+
+}  // namespace test_action_space

@@ -20,6 +20,8 @@
 #include "manisoft/env/rollout.hpp"
 #include "manisoft/rod.hpp"
 
+namespace test_executor {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 namespace control = manisoft::control;
@@ -331,3 +333,5 @@ TEST_CASE("malformed MLP weight files are refused with file and line", "[executo
   }
   CHECK_THROWS_WITH(control::Mlp<double>::load("/nonexistent/weights.txt"), Catch::Contains("/nonexistent/weights.txt"));
 }
+
+}  // namespace test_executor

@@ -14,6 +14,8 @@
 #include "manisoft/env/reach_env.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
 
+namespace test_tracking {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 namespace control = manisoft::control;
@@ -206,3 +208,5 @@ TEST_CASE("pick and place: a few episodes succeed within the step and speed boun
   bad.cube_mass = -1;
   CHECK_THROWS_WITH(manisoft::env::PickPlaceRunner(bad), Catch::Contains("cube_mass"));
 }
+
+}  // namespace test_tracking

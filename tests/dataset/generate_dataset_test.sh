@@ -5,7 +5,8 @@
 # same files; verify_dataset accepts it, and names a truncated episode file; the h5py reader
 # (examples/python/read_dataset.py) reads it; dataset_stats.py draws its plots and export_zarr.py
 # writes Diffusion Policy's zarr layout with the same actions.
-# render_dataset renders the images of a states-only dataset equal to those generated with it.
+# render_dataset renders the images of a states-only dataset equal to those generated with it, and
+# (where Blender is installed) the same frames with Blender.
 # Usage: generate_dataset_test.sh GENERATE VERIFY READ_DATASET_PY PYTHON RENDER_DATASET
 set -euo pipefail
 gen=$1 verify=$2 reader=$3 python=$4 render=$5
@@ -61,6 +62,24 @@ for k in range(6):
         assert np.array_equal(a[f"data/demo_{k}/images/agentview_image_steps"][()], np.arange(0, 50 * len(x), 50))
 PY
 
+# the same frames through Blender (Workbench), where Debian's blender is installed: same steps and
+# sizes as the OpenGL images, a picture in each frame (not one flat colour), and the arm moves
+if command -v "${MANISOFT_BLENDER:-blender}" > /dev/null; then
+  "$render" "$work/one" --out "$work/blender" --every 250 --image-size 48 40 --episodes 1 --renderer blender > /dev/null 2>&1
+  [[ ! -e $work/blender/blender.partial ]] || { echo "FAIL: render_dataset left its Blender scratch folder"; exit 1; }
+  "$python" - "$work/rendered" "$work/blender" <<'PY'
+import sys, h5py, numpy as np
+with h5py.File(f"{sys.argv[1]}/demo_1.hdf5", "r") as a, h5py.File(f"{sys.argv[2]}/demo_1.hdf5", "r") as b:
+    g, x = a["data/demo_1/images"], b["data/demo_1/images"]
+    steps = x["agentview_image_steps"][()]
+    assert np.array_equal(steps, g["agentview_image_steps"][()][::5]), steps
+    img = x["agentview_image"][()]
+    assert img.shape == (len(steps), 40, 48, 3), img.shape
+    assert all(f.std() > 10 for f in img), [f.std() for f in img]
+    assert np.abs(img[0].astype(int) - img[-1].astype(int)).sum() > 0, "first and last Blender frames are identical"
+PY
+fi
+
 # robomimic-style reading with h5py alone
 summary=$("$python" "$reader" "$work/one")  # not piped into grep -q: an early exit would break the reader's pipe
 grep -q "demos 6 " <<< "$summary" || { echo "FAIL: read_dataset.py: $summary"; exit 1; }
@@ -80,5 +99,6 @@ z = zarr.open_group(sys.argv[2], mode="r")
 assert np.array_equal(z["meta/episode_ends"][:], ends), "episode_ends"
 assert np.array_equal(z["data/action"][:], actions), "actions"
 assert z["data/rod_centerline"].shape == (ends[-1], 63), z["data/rod_centerline"].shape
+assert z["data/rod_directors"].shape == (ends[-1], 180), z["data/rod_directors"].shape
 PY
 echo "generate_dataset: 1 shard == 3 shards == killed + resumed; verify, h5py read, stats and zarr export OK"

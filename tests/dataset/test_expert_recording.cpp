@@ -42,6 +42,20 @@ TEST_CASE("a recorded expert episode replays bit for bit, from memory and from i
   for (int i = 0; i < objects; ++i)
     CHECK((e.states.row(0).segment(3 * (n + 1) + 7 * i, 3).transpose() - spec.objects[static_cast<std::size_t>(i)].pose.translation).norm() < 1e-9);
   CHECK(e.states(0, e.states.cols() - 1) == 0.0);
+  // obs/rod_directors: every element's frame orthonormal, its d3 along the centreline (the shear
+  // of the arm at rest is small)
+  const auto& directors = e.observations.at("rod_directors");
+  REQUIRE(directors.cols() == 9 * n);
+  for (const long r : {0L, e.steps() / 2, e.steps() - 1}) {
+    for (int k = 0; k < n; ++k) {
+      Eigen::Matrix3d Q;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) Q(i, j) = directors(r, 9 * k + 3 * i + j);
+      CHECK((Q * Q.transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-9);
+      const Eigen::Vector3d tangent = (e.states.row(r).segment<3>(3 * (k + 1)) - e.states.row(r).segment<3>(3 * k)).transpose().normalized();
+      CHECK(Q.row(2).dot(tangent) > 0.999);
+    }
+  }
   CHECK(e.dones.back() == 1);
   CHECK(e.rewards.sum() == (env.info().success ? 1.0 : 0.0));
   CHECK(e.numbers.at("steps") == static_cast<double>(e.steps()));

@@ -18,6 +18,8 @@
 #include "manisoft/reward/stability_reward.hpp"
 #include "manisoft/reward/sum.hpp"
 
+namespace test_reward {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 namespace math = manisoft::math;
@@ -308,3 +310,5 @@ TEST_CASE("Sum with default terms and weights", "[reward][sum]") {
   CHECK_THROWS_WITH(One({std::numeric_limits<double>::quiet_NaN()}, reward::NonFinitePenalty<>{}),
                     Catch::Contains("weight[0]"));
 }
+
+}  // namespace test_reward

@@ -18,6 +18,8 @@
 #include <numbers>
 #include <random>
 
+namespace test_curved_contact {  // per-file namespace: the group's tests build as one unity translation unit
+
 using namespace manisoft;
 using Eigen::Vector3d;
 using Quat = Eigen::Quaterniond;
@@ -559,3 +561,5 @@ TEST_CASE("the analytic shortcuts agree with GJK/EPA on shallow contacts (random
   }
   CHECK(checked > 300);
 }
+
+}  // namespace test_curved_contact

@@ -14,6 +14,8 @@
 #include <fstream>
 #include <numbers>
 
+namespace test_rigid_shapes {  // per-file namespace: the group's tests build as one unity translation unit
+
 using namespace manisoft;
 using namespace manisoft::geometry;
 using namespace manisoft::rigid;
@@ -207,3 +209,5 @@ TEST_CASE("bad body descriptions are refused naming the body and the value", "[w
   bad.contact_margin = -1;
   CHECK_THROWS_WITH(RigidWorld(bad), Contains("contact_margin"));
 }
+
+}  // namespace test_rigid_shapes

@@ -8,6 +8,8 @@
 
 #include <cstring>
 
+namespace test_rigid_world {  // per-file namespace: the group's tests build as one unity translation unit
+
 using namespace manisoft;
 using namespace manisoft::geometry;
 using namespace manisoft::rigid;
@@ -340,3 +342,5 @@ TEST_CASE("resting bodies fall asleep and wake when pushed", "[world][sleep]") {
   for (auto id : s.bodies) CHECK(w.is_awake(id));  // the whole island wakes
   CHECK(w.linear_velocity(s.bodies[4]).x() > 0);
 }
+
+}  // namespace test_rigid_world

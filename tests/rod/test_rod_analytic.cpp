@@ -11,6 +11,8 @@
 
 #include "manisoft/rod.hpp"
 
+namespace test_rod_analytic {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 using manisoft::rod::RodParameters;
@@ -292,3 +294,5 @@ TEST_CASE("float rods meet the same static solutions with float tolerances", "[r
     CHECK(rod.tip_position().x() - 1.0 == Approx(force * L / (EA - force)).epsilon(2e-3));
   }
 }
+
+}  // namespace test_rod_analytic

@@ -9,6 +9,8 @@
 
 #include "manisoft/rod.hpp"
 
+namespace test_rod_input {  // per-file namespace: the group's tests build as one unity translation unit
+
 using manisoft_test::allocation_count;  // the no-allocation guarantee of step() is counted
 
 namespace {
@@ -161,3 +163,5 @@ TEST_CASE("identical inputs give bit-identical runs", "[rod][determinism]") {
   const auto a = run(), b = run();
   CHECK(same_state(a, b));
 }
+
+}  // namespace test_rod_input

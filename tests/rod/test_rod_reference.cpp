@@ -13,6 +13,8 @@
 
 #include "manisoft/rod.hpp"
 
+namespace test_rod_reference {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 struct Scenario {
@@ -141,3 +143,5 @@ TEST_CASE("float reproduces the n = 20 reference trajectories within float toler
   }
   REQUIRE(checked >= 5);
 }
+
+}  // namespace test_rod_reference

@@ -17,6 +17,8 @@
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/scene/scene_world.hpp"
 
+namespace test_scene {  // per-file namespace: the group's tests build as one unity translation unit
+
 using namespace manisoft;
 using namespace manisoft::scene;
 
@@ -385,3 +387,5 @@ TEST_CASE("describe() gives sampled scenes their instructions: one canonical in 
   REQUIRE(describe(s, sampler().library(), language::Library::load_default(), 1));
   CHECK(s.instruction == "Put the can into the basket.");
 }
+
+}  // namespace test_scene

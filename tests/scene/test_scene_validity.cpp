@@ -21,6 +21,8 @@
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/scene/scene_world.hpp"
 
+namespace test_scene_validity {  // per-file namespace: the group's tests build as one unity translation unit
+
 using namespace manisoft;
 using namespace manisoft::scene;
 
@@ -273,3 +275,5 @@ TEST_CASE("clean placements cover the reachable band (15 scenes per task and set
 }
 
 TEST_CASE("1,000 sampled scenes per task and setting are valid (slow)", "[.][slow]") { run(1000, true, {Task::coll, Task::aln, Task::stk, Task::arr}); }
+
+}  // namespace test_scene_validity

@@ -10,6 +10,8 @@
 
 #include "manisoft/task/success.hpp"
 
+namespace test_success {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 namespace task = manisoft::task;
@@ -235,3 +237,5 @@ TEST_CASE("SuccessTracker: success once after the hold, and whether it holds at 
   CHECK_THROWS_WITH(task::SuccessTracker(0), Catch::Contains("hold_steps = 0"));
   CHECK(task::to_string(task::FailureReason::arm_hit_obstacle) == "arm_hit_obstacle");
 }
+
+}  // namespace test_success

@@ -12,6 +12,8 @@
 #include "manisoft/task/expert.hpp"
 #include "manisoft/task/task_env.hpp"
 
+namespace test_task_env {  // per-file namespace: the group's tests build as one unity translation unit
+
 using Pose = manisoft::math::Pose<double>;
 using manisoft::task::Expert;
 using manisoft::task::FailureReason;
@@ -193,3 +195,5 @@ TEST_CASE("the expert solves fixed clean scenes within the horizon", "[tasks][ex
   }
   CHECK(solved >= 3);
 }
+
+}  // namespace test_task_env

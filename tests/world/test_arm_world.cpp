@@ -10,6 +10,8 @@
 #include "manisoft/world/arm_world.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
 
+namespace test_arm_world {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 using Eigen::Vector3d;
@@ -182,3 +184,5 @@ TEST_CASE("objects leaving the table or the workspace are reported, not fatal", 
   CHECK(w.rigid().center_of_mass(ball).z() > 0);
   CHECK(w.events().size() == 2u);  // reported once
 }
+
+}  // namespace test_arm_world

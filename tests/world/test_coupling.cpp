@@ -8,6 +8,8 @@
 
 #include "manisoft/world/soft_arm_world.hpp"
 
+namespace test_coupling {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 using manisoft::rod::RodParameters;
@@ -146,3 +148,5 @@ TEST_CASE("the default coupling holds gripper plus heaviest object within 1 mm a
   CHECK(worst_separation < 1e-3);  // also during the 2 s swing of the arm settling under the load
   CHECK(worst_angle < 1.0 * 3.14159265358979 / 180);
 }
+
+}  // namespace test_coupling

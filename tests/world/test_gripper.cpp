@@ -10,6 +10,8 @@
 
 #include "manisoft/interaction/gripper.hpp"
 
+namespace test_gripper {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 using Eigen::Vector3d;
@@ -168,3 +170,5 @@ TEST_CASE("the gripper refuses bad commands and parameters", "[world][gripper]")
   p.mass = -1;
   CHECK_THROWS_WITH(manisoft::interaction::make_parallel_gripper(p), Catch::Matchers::Contains("mass = -1"));
 }
+
+}  // namespace test_gripper

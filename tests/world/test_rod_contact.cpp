@@ -11,6 +11,8 @@
 
 #include "manisoft/world/arm_world.hpp"
 
+namespace test_rod_contact {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 using manisoft::rod::RodParameters;
@@ -304,3 +306,5 @@ TEST_CASE("an arm swung at top speed into a box stops against it", "[world][rod_
     CHECK(r.max_penetration < (couple < 20 ? 0.0072 : 0.016));
   }
 }
+
+}  // namespace test_rod_contact

@@ -10,6 +10,8 @@
 
 #include "manisoft/world/arm_world.hpp"
 
+namespace test_rollback {  // per-file namespace: the group's tests build as one unity translation unit
+
 namespace {
 
 using Eigen::Vector3d;
@@ -230,3 +232,5 @@ TEST_CASE("a rigid world snapshot restores contacts, caches and counters", "[wor
   CHECK(moved.state(3).position.allFinite());
   CHECK(moved.touching_point_count() >= 4);
 }
+
+}  // namespace test_rollback

@@ -17,6 +17,8 @@
 #include "manisoft/world/arm_world.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
 
+namespace test_world_alloc {  // per-file namespace: the group's tests build as one unity translation unit
+
 using manisoft_test::allocation_count;
 
 namespace {
@@ -139,3 +141,5 @@ TEST_CASE("a reach episode allocates nothing after the target's set-up", "[execu
     CHECK(episode_allocations(env, executor, 7, success) == 0);
   }
 }
+
+}  // namespace test_world_alloc

@@ -8,6 +8,8 @@
 //   obs/eef_pose      the end-effector frame (position, quaternion w x y z)
 //   obs/gripper       finger width (m), S
 //   obs/rod_centerline (n+1) x 3 node positions
+//   obs/rod_directors n x 9: element k's directors, column 3 i + j = Q_k(i, j) (rows of Q_k are
+//                     d1, d2, d3 in world coordinates; d3 is the element's tangent)
 //   obs/object_poses  7 per object
 //   rewards           1 at the step the task succeeded, else 0; dones 1 at the last step
 // Attributes: task, setting, split, scene (JSON), instruction, instructions_seen and
@@ -62,6 +64,7 @@ class EpisodeRecorder {
     eef_.resize(t, 7);
     gripper_.resize(t, 2);
     rod_.resize(t, 3 * (n + 1));
+    directors_.resize(t, 9 * n);
     objects_.resize(t, 7 * objects);
   }
 
@@ -81,6 +84,8 @@ class EpisodeRecorder {
     rod_.row(r) = e_.states.row(r).head(nr);
     objects_.row(r) = e_.states.row(r).segment(nr, no);
     gripper_.row(r) = e_.states.row(r).tail(2);
+    const auto& directors = env_->world().rod().state().directors;
+    for (Eigen::Index k = 0; k < directors.rows(); ++k) directors_.row(r).segment<9>(9 * k) = directors.row(k);
   }
 
   /// The episode (`index`: demo_<index>) once TaskEnv is done; `seed`, `redraws` and the scene's
@@ -99,6 +104,7 @@ class EpisodeRecorder {
     e.observations["eef_pose"] = eef_.topRows(t);
     e.observations["gripper"] = gripper_.topRows(t);
     e.observations["rod_centerline"] = rod_.topRows(t);
+    e.observations["rod_directors"] = directors_.topRows(t);
     e.observations["object_poses"] = objects_.topRows(t);
     const scene::SceneSpec& s = env_->spec();
     e.text["task"] = std::string(scene::to_string(s.task));
@@ -120,7 +126,7 @@ class EpisodeRecorder {
  private:
   const task::TaskEnv* env_;
   Episode e_;
-  StepMatrix eef_, gripper_, rod_, objects_;
+  StepMatrix eef_, gripper_, rod_, directors_, objects_;
   long rows_ = 0;
 };
 
