@@ -222,10 +222,10 @@ class Expert {
     return a;
   }
 
-  /// Height (world z) of the open fingertips at end-effector pose `p`.
-  double tips_z(const Pose& p) const {
+  /// Where the fingertips are (world) at end-effector pose `p`.
+  Vec3 fingertips(const Pose& p) const {
     const auto& gp = env_->gripper_parameters();
-    return p.act(Vec3(0, 0, gp.palm_thickness + gp.finger_length)).z();
+    return p.act(Vec3(0, 0, gp.palm_thickness + gp.finger_length));
   }
   /// Height (world z) of object i's top as it stands now.
   double top_of(int object) const { return state_of(object).pose.act(Vec3(0, 0, scene::asset_height(asset_of(object)))).z(); }
@@ -241,7 +241,7 @@ class Expert {
       Pose above = approach;
       above.translation.z() = std::max(approach.translation.z(), from.translation.z());
       if (is_tall(p.object))
-        above.translation.z() = std::max(above.translation.z(), approach.translation.z() + top_of(p.object) + config_.approach_tip_clearance - tips_z(approach));
+        above.translation.z() = std::max(above.translation.z(), approach.translation.z() + top_of(p.object) + config_.approach_tip_clearance - fingertips(approach).z());
       append_leg(p.approach_leg, prev, above);
       prev = above;
     }
@@ -266,7 +266,7 @@ class Expert {
       for (int k = 1; k <= samples; ++k) {
         Pose x = to;
         x.translation = prev.translation + (double(k) / samples) * (to.translation - prev.translation);
-        const Vec3 tips = x.act(Vec3(0, 0, gp.palm_thickness + gp.finger_length));
+        const Vec3 tips = fingertips(x);
         const double d = (tips.head<2>() - axis).norm();
         if (tips.z() < top + config_.approach_tip_clearance && d > between && d < reach) return false;
       }
@@ -587,11 +587,8 @@ class Expert {
   /// Above the place pose by retract_height, or more until the fingertips are finger_clearance
   /// above the released object's top.
   Pose retract_pose() const {
-    const auto& gp = env_->gripper_parameters();
-    const double tips = plan_.place.act(Vec3(0, 0, gp.palm_thickness + gp.finger_length)).z();
-    const double top_of_object = state_of(plan_.object).pose.act(Vec3(0, 0, scene::asset_height(asset_of(plan_.object)))).z();
     Pose up = plan_.place;
-    up.translation.z() += std::max(config_.retract_height, top_of_object + config_.finger_clearance - tips);
+    up.translation.z() += std::max(config_.retract_height, top_of(plan_.object) + config_.finger_clearance - fingertips(plan_.place).z());
     return up;
   }
 
