@@ -40,8 +40,9 @@ inline rigid::BodyId add(rigid::RigidWorld& w, geometry::Shape<double> shape, Ei
   return w.add_body(d);
 }
 
-inline rigid::BodyId add_table(rigid::RigidWorld& w) {
+inline rigid::BodyId add_table(rigid::RigidWorld& w, double rolling_resistance = 0) {
   rigid::RigidBodyDesc d;
+  d.rolling_resistance = rolling_resistance;
   d.shape = geometry::Box<double>{Eigen::Vector3d(0.6, 0.4, 0.02)};
   d.position = {0, 0, -0.02};
   d.is_static = true;

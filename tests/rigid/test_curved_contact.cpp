@@ -349,6 +349,47 @@ TEST_CASE("a cylinder lying on an incline rolls at 2/3 g sin t and slips at g (s
   }
 }
 
+TEST_CASE("rolling resistance: a can rolling on the table slows at r_roll g / (1.5 r), a rocking one comes to rest", "[world][cylinder][rolling]") {
+  rigid::RigidWorldSettings st;
+  st.enable_sleep = false;
+  SECTION("lying, rolling at 0.3 m/s: deceleration from the energy balance") {
+    // Rolling without slip with a resisting couple r_roll N: d/dt (m v^2 / 2 + I w^2 / 2) = -r_roll m g w,
+    // w = v / r, I = m r^2 / 2  =>  a = -r_roll g / (1.5 r). With r_roll = 0 it rolls on at 0.3 m/s.
+    for (const double r_roll : {0.0, 1e-3}) {
+      rigid::RigidWorld w(st);
+      scenes::add_table(w, r_roll);
+      const auto can = scenes::add(w, geometry::Cylinder<double>{kR, kH}, {-0.3, 0, kR}, 800, about_x(std::numbers::pi / 2));
+      w.set_velocity(can, {0.3, 0, 0}, {0, 0.3 / kR, 0});
+      for (int i = 0; i < 250; ++i) w.step(kDt);  // into the soft contact
+      const double v0 = w.linear_velocity(can).x(), t0 = w.time();
+      for (int i = 0; i < 2500; ++i) w.step(kDt);
+      const double a = (w.linear_velocity(can).x() - v0) / (w.time() - t0);
+      const double expected = -r_roll * 9.81 / (1.5 * kR);
+      INFO("r_roll " << r_roll << " m: a = " << a << " m/s^2, expected " << expected << "; spin " << w.angular_velocity(can).y() * kR
+                     << " m/s vs v " << w.linear_velocity(can).x());
+      CHECK(a == Approx(expected).margin(2e-3).epsilon(0.03));
+      CHECK(w.angular_velocity(can).y() * kR == Approx(w.linear_velocity(can).x()).margin(1e-4));  // still rolling, not sliding
+    }
+  }
+  SECTION("standing, tilted 0.01 rad on its rim and spinning: at rest within 0.5 s with 0.5 mm, later without") {
+    double rest_time[2] = {INFINITY, INFINITY};
+    for (int k = 0; k < 2; ++k) {
+      rigid::RigidWorld w(st);
+      scenes::add_table(w, k == 0 ? 0.0 : 5e-4);
+      const double r = 0.0175, h = 0.1, tilt = 0.01;  // a candle stick's collision cylinder
+      const auto id = scenes::add(w, geometry::Cylinder<double>{r, h}, {0, 0, h * std::cos(tilt) + r * std::sin(tilt)}, 800, about_y(tilt));
+      w.set_velocity(id, Vector3d::Zero(), {0, 0, 1.0});
+      for (int i = 1; i <= 10000 && !std::isfinite(rest_time[k]); ++i) {
+        w.step(kDt);
+        if (w.angular_velocity(id).norm() < 0.01 && w.linear_velocity(id).norm() < 1e-3) rest_time[k] = w.time();
+      }
+    }
+    INFO("at rest (|w| < 0.01 rad/s) after " << rest_time[0] << " s without rolling resistance, " << rest_time[1] << " s with 0.5 mm");
+    CHECK(rest_time[1] < 0.5);
+    CHECK(rest_time[1] < rest_time[0]);
+  }
+}
+
 TEST_CASE("a standing and a lying cylinder rest on the table for 5 s", "[world][cylinder][rest]") {
   rigid::RigidWorldSettings st;
   st.enable_sleep = false;  // the solver itself, not the sleeping shortcut

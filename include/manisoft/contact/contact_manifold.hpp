@@ -45,6 +45,9 @@ struct PatchFriction {
   Eigen::Vector2d impulse{Eigen::Vector2d::Zero()};       ///< in the (t1, t2) basis
   Eigen::Vector2d drift_2d{Eigen::Vector2d::Zero()};
   double twist_mass{0}, twist_radius{0};
+  Eigen::Matrix2d rolling_mass{Eigen::Matrix2d::Zero()};   ///< inverse of t_i . (Ia^-1 + Ib^-1) t_j
+  Eigen::Vector2d rolling_impulse{Eigen::Vector2d::Zero()}; ///< angular, (t1, t2) basis, this step
+  std::array<Vec3, 2> ia_t{Vec3::Zero(), Vec3::Zero()}, ib_t{Vec3::Zero(), Vec3::Zero()};
   bool sliding{false}, twisting{false};
   std::array<Vec3, 2> ra_x_t{Vec3::Zero(), Vec3::Zero()}, rb_x_t{Vec3::Zero(), Vec3::Zero()};
   std::array<Vec3, 2> ia_ra_x_t{Vec3::Zero(), Vec3::Zero()}, ib_rb_x_t{Vec3::Zero(), Vec3::Zero()};
@@ -56,7 +59,7 @@ struct ContactManifold {
   std::uint32_t body_a{0}, body_b{0};
   Vec3 normal_local{Vec3::UnitZ()};    ///< in the owner body's frame, pointing from A to B
   NormalOwner owner{NormalOwner::shape_a};
-  double friction{0.5}, restitution{0};
+  double friction{0.5}, restitution{0}, rolling_resistance{0};
   int count{0};
   std::array<ManifoldPoint, kMaxContactPoints> points{};
   PatchFriction patch{};
@@ -80,7 +83,7 @@ struct ManifoldMemory {
   NormalOwner owner{NormalOwner::shape_a};
   bool fresh{true}, rolling{false};
   int count{0};
-  double friction{0.5}, restitution{0}, travel_a{0}, travel_b{0};
+  double friction{0.5}, restitution{0}, rolling_resistance{0}, travel_a{0}, travel_b{0};
   struct Point {
     Vec3 anchor_a{Vec3::Zero()}, anchor_b{Vec3::Zero()};
     double base_separation{0}, normal_impulse{0};
@@ -102,6 +105,7 @@ struct ManifoldMemory {
     r.count = m.count;
     r.friction = m.friction;
     r.restitution = m.restitution;
+    r.rolling_resistance = m.rolling_resistance;
     r.travel_a = m.travel_a;
     r.travel_b = m.travel_b;
     for (int k = 0; k < m.count; ++k) {
@@ -128,6 +132,7 @@ struct ManifoldMemory {
     m.count = count;
     m.friction = friction;
     m.restitution = restitution;
+    m.rolling_resistance = rolling_resistance;
     m.travel_a = travel_a;
     m.travel_b = travel_b;
     for (int k = 0; k < count; ++k) {

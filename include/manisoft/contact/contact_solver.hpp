@@ -25,6 +25,13 @@
 // dissipation). A clamped patch slides and its drift is reset; a patch inside the disc sticks and
 // the anchor spring pulls any creep back: true static friction, no creep on inclines. Twist about
 // the normal: the same with a scalar impulse bounded by mu sum(lambda_n) r_twist.
+// Rolling resistance (per patch, when the pair's length r_roll > 0): the relative angular velocity
+// in the tangent plane is driven to zero by a 2D angular impulse bounded by r_roll sum(lambda_n),
+// the torque of the normal force shifted r_roll ahead of the contact as real surfaces deform
+// (the rolling-resistance length of engineering tables; ODE, Bullet and MuJoCo model it so).
+// Rigid point contact has none: a round base released a hair off flat rolls on its rim forever
+// (Euler's disk without its dissipation), and a cylinder on its side rolls on at constant speed.
+// Velocity level only (no anchor, no warm start): it removes rolling, it never drives it.
 // Relax: the same with bias = 0 (rigid), so the velocity left after the step carries no
 // position-correction term. Restitution: after relax, points that approached faster than the
 // threshold get lambda such that v_n = -e v_n,before.
@@ -153,6 +160,20 @@ void prepare_contacts(std::vector<ContactManifold>& manifolds, const BodyStates&
     f.tangent_mass = det > 0 ? Eigen::Matrix2d(f.tangent_k.inverse()) : Eigen::Matrix2d::Zero();
     const double kw = n.dot(ba.inv_inertia * n) + n.dot(bb.inv_inertia * n);
     f.twist_mass = kw > 0 ? 1.0 / kw : 0.0;
+    if (m.rolling_resistance > 0) {
+      Eigen::Matrix2d kr;
+      for (int i = 0; i < 2; ++i) {
+        f.ia_t[static_cast<std::size_t>(i)] = ba.inv_inertia * t[i];
+        f.ib_t[static_cast<std::size_t>(i)] = bb.inv_inertia * t[i];
+      }
+      for (int i = 0; i < 2; ++i) {
+        for (int j = 0; j < 2; ++j) {
+          kr(i, j) = t[i].dot(f.ia_t[static_cast<std::size_t>(j)] + f.ib_t[static_cast<std::size_t>(j)]);
+        }
+      }
+      f.rolling_mass = kr.determinant() > 0 ? Eigen::Matrix2d(kr.inverse()) : Eigen::Matrix2d::Zero();
+    }
+    f.rolling_impulse.setZero();
     f.impulse = {t[0].dot(f.tangent_impulse), t[1].dot(f.tangent_impulse)};
     f.drift_2d = {t[0].dot(f.drift), t[1].dot(f.drift)};
     f.sliding = false;
@@ -245,6 +266,18 @@ inline void solve_contacts(std::vector<ContactManifold>& manifolds, std::vector<
       ba.w -= (lambda - f.twist_impulse) * f.ia_n;
       bb.w += (lambda - f.twist_impulse) * f.ib_n;
       f.twist_impulse = lambda;
+    }
+    // Rolling resistance about the tangent axes.
+    if (m.rolling_resistance > 0 && total_normal > 0) {
+      const Vec3 dw = bb.w - ba.w;
+      const Eigen::Vector2d wt(m.tangent1.dot(dw), m.tangent2.dot(dw));
+      Eigen::Vector2d lambda = f.rolling_impulse - f.rolling_mass * wt;
+      const double limit = m.rolling_resistance * total_normal, mag = lambda.norm();
+      if (mag > limit) lambda *= limit / mag;
+      const Eigen::Vector2d d_lambda = lambda - f.rolling_impulse;
+      f.rolling_impulse = lambda;
+      ba.w -= d_lambda[0] * f.ia_t[0] + d_lambda[1] * f.ia_t[1];
+      bb.w += d_lambda[0] * f.ib_t[0] + d_lambda[1] * f.ib_t[1];
     }
     // Non-penetration.
     for (int k = 0; k < m.count; ++k) {

@@ -30,6 +30,9 @@ struct RigidBodyDesc {
   Eigen::Vector3d angular_velocity{Eigen::Vector3d::Zero()};  ///< world
   double friction{0.5};     ///< Coulomb coefficient (pairs use the geometric mean)
   double restitution{0.0};  ///< 0..1 (pairs use the larger)
+  /// Rolling resistance length, m: the contact resists rolling with a torque of at most this
+  /// times the normal force (pairs use the larger; 0: none). See contact_solver.hpp.
+  double rolling_resistance{0.0};
   bool is_static{false};
   std::string name;
 };
@@ -42,7 +45,7 @@ struct RigidBodyModel {
   Eigen::Matrix3d inertia{Eigen::Matrix3d::Zero()};          ///< about the COM, body axes
   Eigen::Matrix3d inverse_inertia{Eigen::Matrix3d::Zero()};  ///< zero for static bodies
   Eigen::Vector3d center_of_mass{Eigen::Vector3d::Zero()};   ///< in the shape frame
-  double friction{0.5}, restitution{0};
+  double friction{0.5}, restitution{0}, rolling_resistance{0};
   std::uint32_t first_geom{0}, geom_count{0};
   double bounding_radius{0};  ///< of all geometry about the COM
 };
@@ -113,6 +116,9 @@ inline RigidBodyModel make_body_model(const RigidBodyDesc& desc, BodyId id) {
   if (!std::isfinite(desc.restitution) || desc.restitution < 0 || desc.restitution > 1) {
     manisoft::detail::fail(who(), ": restitution = ", desc.restitution, " must be in [0, 1]");
   }
+  if (!std::isfinite(desc.rolling_resistance) || desc.rolling_resistance < 0) {
+    manisoft::detail::fail(who(), ": rolling_resistance = ", desc.rolling_resistance, " m must be finite and >= 0");
+  }
   if (!desc.position.allFinite() || !desc.linear_velocity.allFinite() || !desc.angular_velocity.allFinite() ||
       !desc.orientation.coeffs().allFinite() || desc.orientation.norm() < 1e-9) {
     manisoft::detail::fail(who(), ": position, orientation and velocities must be finite (and the quaternion non-zero)");
@@ -120,6 +126,7 @@ inline RigidBodyModel make_body_model(const RigidBodyDesc& desc, BodyId id) {
   validate_shape(desc.shape, who());
   m.friction = desc.friction;
   m.restitution = desc.restitution;
+  m.rolling_resistance = desc.rolling_resistance;
   if (desc.is_static) {
     // Mass properties only for the centre of mass (to place the geometry); density may be 0.
     m.center_of_mass = geometry::mass_properties(desc.shape, 1.0).center_of_mass;

@@ -198,6 +198,7 @@ inline nlohmann::json to_json(const SceneSpec& s) {
                     {"half_y", number(s.table.half_y, "table.half_y")},
                     {"thickness", number(s.table.thickness, "table.thickness")},
                     {"friction", number(s.table.friction, "table.friction")},
+                    {"rolling_resistance", number(s.table.rolling_resistance, "table.rolling_resistance")},
                     {"texture", json_detail::texture_name(s.table.texture)},
                     {"color", vec(s.table.color, "table.color")},
                     {"secondary_color", vec(s.table.secondary_color, "table.secondary_color")},
@@ -274,6 +275,8 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
   s.table.half_y = rd.num(t, "half_y", "table");
   s.table.thickness = rd.num(t, "thickness", "table");
   s.table.friction = rd.num(t, "friction", "table");
+  // Optional (scenes written before rolling resistance existed keep the default).
+  if (t.contains("rolling_resistance")) s.table.rolling_resistance = rd.num(t, "rolling_resistance", "table");
   s.table.texture = rd.name_of(t, "texture", "table", json_detail::texture_names);
   s.table.color = rd.vec3(t, "color", "table");
   s.table.secondary_color = rd.vec3(t, "secondary_color", "table");

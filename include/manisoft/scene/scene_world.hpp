@@ -28,6 +28,7 @@ inline rigid::RigidBodyDesc asset_body(const assets::Asset& a, const math::Pose<
   d.position = pose.translation;
   d.orientation = Eigen::Quaterniond(pose.rotation).normalized();
   d.friction = a.friction;
+  d.rolling_resistance = a.rolling_resistance;
   d.is_static = is_static;
   d.name = name;
   return d;
@@ -90,6 +91,7 @@ inline SceneBodies populate_rigid_world(rigid::RigidWorld& world, const SceneSpe
   t.position = s.table.top_center - Eigen::Vector3d(0, 0, 0.5 * s.table.thickness);
   t.is_static = true;
   t.friction = s.table.friction;
+  t.rolling_resistance = s.table.rolling_resistance;
   t.name = "table";
   b.table = world.add_body(t);
   for (std::size_t i = 0; i < s.obstacles.size(); ++i) {

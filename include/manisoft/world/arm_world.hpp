@@ -55,6 +55,7 @@ struct TableDesc {
   double half_x = 0.4, half_y = 0.5;  ///< m, of the top
   double thickness = 0.05;            ///< m (the collision box below the top face)
   double friction = 0.6;
+  double rolling_resistance = 5e-4;   ///< m (rigid::RigidBodyDesc::rolling_resistance), also the floor's
   bool add_floor = true;              ///< a static floor at z = 0 catches fallen objects
 };
 
@@ -116,6 +117,7 @@ class ArmWorld {
     d.position = t.top_center - Vec3(0, 0, 0.5 * t.thickness);
     d.is_static = true;
     d.friction = t.friction;
+    d.rolling_resistance = t.rolling_resistance;
     d.name = "table";
     table_ = t;
     table_id_ = add_body(d);
@@ -126,6 +128,7 @@ class ArmWorld {
       f.position = Vec3(t.top_center.x(), t.top_center.y(), -0.05);
       f.is_static = true;
       f.friction = t.friction;
+      f.rolling_resistance = t.rolling_resistance;
       f.name = "floor";
       add_body(f);
     }
