@@ -4,6 +4,8 @@
 //                                  (task, setting, scene JSON, instructions JSON, ...) and every
 //                                  Episode::numbers entry (success, seed, ...)
 //   /data/demo_<k>/actions         float64 T x (3 n + 1): element torques row by row, then S
+//                                  (actions, states and obs arrays: byte shuffle + gzip, chunks
+//                                  of 256 steps; about 3/4 of the raw size)
 //   /data/demo_<k>/states          float64 T x D: the state before each action (replay)
 //   /data/demo_<k>/rewards         float64 T
 //   /data/demo_<k>/dones           uint8 T
@@ -48,12 +50,16 @@ inline void write_episode(const std::filesystem::path& path, const Episode& epis
     const std::string demo = demo_path(episode.index);
     file.create_groups(demo + "/obs");
     const auto t = static_cast<hsize_t>(episode.steps());
-    file.write(demo + "/actions", {t, static_cast<hsize_t>(episode.actions.cols())}, episode.actions.data());
-    file.write(demo + "/states", {t, static_cast<hsize_t>(episode.states.cols())}, episode.states.data());
+    constexpr int array_level = 4;
+    constexpr hsize_t array_rows = 256;
+    auto write_array = [&](const std::string& name, const auto& m) {
+      file.write(demo + name, {t, static_cast<hsize_t>(m.cols())}, m.data(), array_level, array_rows, true);
+    };
+    write_array("/actions", episode.actions);
+    write_array("/states", episode.states);
     file.write(demo + "/rewards", {t}, episode.rewards.data());
     file.write(demo + "/dones", {t}, episode.dones.data());
-    for (const auto& [name, m] : episode.observations)
-      file.write(demo + "/obs/" + name, {t, static_cast<hsize_t>(m.cols())}, m.data());
+    for (const auto& [name, m] : episode.observations) write_array("/obs/" + name, m);
     for (const auto& [name, seq] : episode.images) {
       const std::vector<hsize_t> shape{static_cast<hsize_t>(seq.frames), static_cast<hsize_t>(seq.height),
                                        static_cast<hsize_t>(seq.width), 3};

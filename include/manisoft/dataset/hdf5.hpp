@@ -141,10 +141,14 @@ class File {
     }
   }
 
-  /// Writes a row-major array of `shape` (a new dataset). `chunk` rows per chunk and gzip
-  /// `compression` (0-9) when compression > 0 (images).
+  /// Writes a row-major array of `shape` (a new dataset). When compression > 0: gzip at that
+  /// level (1-9), `chunk_rows` rows of the first dimension per chunk (1 for images: reading frame t
+  /// decompresses frame t only), and with `shuffle` HDF5's byte shuffle first (the bytes of equal
+  /// significance of neighbouring numbers side by side: smooth float64 series compress far
+  /// better). Both filters are built into HDF5 and h5py.
   template <typename T>
-  void write(const std::string& path, const std::vector<hsize_t>& shape, const T* values, int compression = 0) {
+  void write(const std::string& path, const std::vector<hsize_t>& shape, const T* values, int compression = 0,
+             hsize_t chunk_rows = 1, bool shuffle = false) {
     ScopedSilence silence;
     Handle space(H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr), H5Sclose);
     Handle properties(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
@@ -153,8 +157,9 @@ class File {
     for (hsize_t s : shape) empty = empty || s == 0;
     if (compression > 0 && !empty) {
       std::vector<hsize_t> chunk = shape;
-      chunk[0] = 1;  // one frame a chunk: reading frame t decompresses frame t only
+      chunk[0] = std::clamp<hsize_t>(chunk_rows, 1, shape[0]);
       H5Pset_chunk(properties.get(), static_cast<int>(chunk.size()), chunk.data());
+      if (shuffle) H5Pset_shuffle(properties.get());
       H5Pset_deflate(properties.get(), static_cast<unsigned>(compression));
     }
     Handle data(H5Dcreate2(id(), path.c_str(), native_type<T>(), space.get(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
