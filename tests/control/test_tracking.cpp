@@ -86,6 +86,52 @@ TEST_CASE("a 4 cm move keeps the shape branch at gripper yaws of 90 and 180 degr
   }
 }
 
+TEST_CASE("solve_near bends a path's shapes around the actuation limits (actuator relief)", "[executor][tracking]") {
+  // From the tasks' home pose across the table at a fixed tool-down orientation, in 1 cm knots
+  // each warm-started from the previous one (the executor's path planning). Minimum-norm steps
+  // alone run the shape into the torque limits; with relief the same path stays within them.
+  // Independent checks: each knot's shape, by forward statics, meets its pose; the linear blend
+  // between consecutive knots (what the executor interpolates) moves the tip along a path at
+  // most 1.5 x the straight distance plus 1 mm.
+  const Eigen::Vector3d waypoints[] = {{0.5, 0.0, 0.965}, {0.388, -0.322, 1.04}, {0.489, 0.071, 1.04}};
+  const auto run = [&](int relief_iterations, double& worst_ratio, double& worst_blend) {
+    manisoft::rod::InverseStaticsSettings<double> settings;
+    settings.relief_iterations = relief_iterations;
+    manisoft::rod::InverseStatics<double> statics(tabletop_model(), settings, {150, 75});
+    REQUIRE(statics.solve_cold(tool_down(waypoints[0], 0.0)).within_limits);
+    worst_ratio = 0;
+    worst_blend = 0;
+    for (int leg = 1; leg < 3; ++leg) {
+      const int knots = static_cast<int>(std::ceil((waypoints[leg] - waypoints[leg - 1]).norm() / 0.01));
+      for (int i = 1; i <= knots; ++i) {
+        const Pose knot = tool_down(waypoints[leg - 1] + (double(i) / knots) * (waypoints[leg] - waypoints[leg - 1]), 0.0);
+        const auto from = statics.coefficients();
+        const Pose from_pose = statics.tip_pose(from);
+        const auto r = statics.solve_near(knot, from, 8);
+        REQUIRE(r.converged);
+        worst_ratio = std::max(worst_ratio, r.max_torque_ratio);
+        const auto to = statics.coefficients();
+        CHECK((statics.tip_pose(to).translation - knot.translation).norm() < 1e-9);
+        double path = 0;
+        Eigen::Vector3d previous = from_pose.translation;
+        for (int k = 1; k <= 16; ++k) {
+          const Eigen::Vector3d x = statics.tip_pose(from + (k / 16.0) * (to - from)).translation;
+          path += (x - previous).norm();
+          previous = x;
+        }
+        worst_blend = std::max(worst_blend, path - 1.5 * (knot.translation - from_pose.translation).norm());
+      }
+    }
+  };
+  double ratio_off = 0, blend_off = 0, ratio_on = 0, blend_on = 0;
+  run(0, ratio_off, blend_off);
+  run(2, ratio_on, blend_on);
+  CAPTURE(ratio_off, blend_off, ratio_on, blend_on);
+  CHECK(ratio_off > 1.0);
+  CHECK(ratio_on <= 1.0);
+  CHECK(blend_on <= 1e-3);
+}
+
 TEST_CASE("a path the arm cannot hold is refused and leaves the executor as it was", "[executor][tracking]") {
   control::ModelExecutor<double> executor(tabletop_model(), {150, 75});
   const Pose start = tool_down({0.5, 0.0, 0.93}, 0.0);

@@ -52,7 +52,8 @@
 //             along the geodesic) with quintic (minimum-jerk) timing over a given number of
 //             control steps. At set-up the path is cut into knots (at most knot_spacing m or
 //             knot_angle rad apart, at least one per max_knot_steps) and the inverse statics is
-//             solved at each knot warm-started from the previous knot's shape, so the shape target
+//             solved at each knot warm-started from the previous knot's shape (solve_near: the
+//             smallest shape change, relieving actuators that near their limits), so the shape target
 //             moves continuously with the path and never restarts a ramp; between knots the
 //             curvature coefficients are interpolated linearly in time. Continuity check: the tip
 //             path of each knot-to-knot blend (sampled) must stay within path_ratio_limit times

@@ -99,6 +99,9 @@ struct InverseStaticsSettings {
   int library_size = 1500;                    ///< start shapes of solve_cold's library
   int cold_starts = 6;                        ///< starts tried by solve_cold (library + last + straight)
   int cold_iteration_budget = 120;            ///< LM iterations of solve_cold over all starts
+  Scalar relief_threshold = Scalar(0.6);      ///< solve_near: torque ratio above which it relieves the actuators
+  Scalar relief_step = Scalar(0.5);           ///< solve_near: largest relief step (coefficient change, 1/m)
+  int relief_iterations = 2;                  ///< solve_near: relief steps per call (0: off)
 };
 
 template <typename Scalar>
@@ -134,6 +137,10 @@ class InverseStatics {
     manisoft::detail::require_non_negative("InverseStatics regularization", settings_.regularization);
     manisoft::detail::require_positive("InverseStatics reference_torque", settings_.reference_torque);
     manisoft::detail::require_non_negative("InverseStatics curvature_weight", settings_.curvature_weight);
+    if (!(settings_.relief_threshold > 0 && settings_.relief_threshold < 1))
+      manisoft::detail::fail("InverseStatics relief_threshold = ", settings_.relief_threshold, " must be in (0, 1)");
+    manisoft::detail::require_non_negative("InverseStatics relief_step", settings_.relief_step);
+    if (settings_.relief_iterations < 0) manisoft::detail::fail("InverseStatics relief_iterations = ", settings_.relief_iterations, " must be >= 0");
     manisoft::detail::require_positive("ActuationLimits bend", limits_.bend);
     manisoft::detail::require_positive("ActuationLimits twist", limits_.twist);
     if (!model_.base_position.allFinite() || !model_.base_directors.allFinite())
@@ -299,14 +306,18 @@ class InverseStatics {
   /// Solves for a target near the shape `start` by minimum-effort-norm Gauss-Newton steps only
   /// (stage 3 below, at most `max_iterations`): the smallest change of the shape (in the effort
   /// norm W) that meets the target, so a path of nearby targets gives a continuous shape
-  /// sequence. No LM, no polish: ~4 iterations for a 1 cm step. The result becomes the committed
-  /// solution; when it has not converged the caller can fall back to solve_from. Does not allocate.
+  /// sequence. No LM, no polish: ~4 iterations for a 1 cm step. When the solution's largest
+  /// torque ratio exceeds relief_threshold, up to relief_iterations small steps at the same tip
+  /// pose lower it (relieve()): a path's shapes then bend around the actuation limits instead of
+  /// running into them. The result becomes the committed solution; when it has not converged the
+  /// caller can fall back to solve_from. Does not allocate.
   InverseStaticsResult<Scalar> solve_near(const Pose& target, const Coefficients& start, int max_iterations = 8) {
     require_finite_target(target);
     if (!start.allFinite()) manisoft::detail::fail("InverseStatics: the start coefficients are not finite");
     Coefficients c = start;
     Residual r = residual(c, target);
-    const int it = newton(target, c, r, max_iterations, true);
+    int it = newton(target, c, r, max_iterations, true);
+    if (r.norm() < settings_.accept_error) it += relieve(target, c, r);
     shape(c);
     coefficients_ = c;
     commit();
@@ -406,6 +417,69 @@ class InverseStatics {
       if (done) break;
     }
     return p;
+  }
+
+  /// Actuator relief (solve_near): while the shape's largest torque ratio exceeds
+  /// relief_threshold, a step along the shapes with the same tip pose (the null space of the tip
+  /// Jacobian, steepest descent in the W metric: gradient projection, Liegeois 1977) lowers the
+  /// effort E(c) = sum over actuated entries of (tau_ff / limit)^8 (a smooth stand-in for the
+  /// largest ratio, gradient by forward differences); Newton steps then return to the target. The
+  /// step's length (Euclidean, in coefficients) grows from 0 at the threshold to relief_step at the limit, so a path's shapes
+  /// change gradually (the continuity check of the executor sees every step). A step is kept only
+  /// if it meets the target and lowers E. Returns the Newton iterations used.
+  int relieve(const Pose& target, Coefficients& c, Residual& r) {
+    int used = 0;
+    for (int step = 0; step < settings_.relief_iterations; ++step) {
+      Scalar ratio = 0;
+      const Scalar e0 = effort(c, ratio);
+      if (!(ratio > settings_.relief_threshold)) break;
+      Coefficients g;
+      for (int j = 0; j < n_coefficients; ++j) {
+        Coefficients cj = c;
+        const Scalar h = Scalar(1e-6) * (Scalar(1) + std::abs(c[j]));
+        cj[j] += h;
+        Scalar unused = 0;
+        g[j] = (effort(cj, unused) - e0) / h;
+      }
+      jacobian(c, r, target);
+      const Eigen::Matrix<Scalar, n_coefficients, 6> wj = regularizer_inverse_ * jacobian_.transpose();
+      const Eigen::Matrix<Scalar, 6, 6> m = jacobian_ * wj;
+      const Coefficients wg = regularizer_inverse_ * g;
+      const Coefficients d = -(wg - wj * m.ldlt().solve(jacobian_ * wg));  // W-projected descent
+      const Scalar d_norm = d.norm();
+      if (!(d_norm > Scalar(0))) break;
+      const Scalar strength = std::min(Scalar(1), (ratio - settings_.relief_threshold) / (Scalar(1) - settings_.relief_threshold));
+      const Scalar length = settings_.relief_step * strength;
+      bool kept = false;
+      for (int half = 0; half < 4 && !kept; ++half) {
+        Coefficients trial = c + std::ldexp(length / d_norm, -half) * d;
+        Residual r_trial = residual(trial, target);
+        used += newton(target, trial, r_trial, 4);
+        Scalar unused = 0;
+        if (r_trial.norm() < settings_.accept_error && effort(trial, unused) < e0) {
+          c = trial;
+          r = r_trial;
+          kept = true;
+        }
+      }
+      if (!kept) break;
+    }
+    return used;
+  }
+
+  /// E(c) of relieve() and the largest torque ratio (commits c's shape to the feed-forward buffers).
+  Scalar effort(const Coefficients& c, Scalar& max_ratio) {
+    shape(c);
+    commit();
+    Scalar e = 0;
+    max_ratio = 0;
+    for (int k = 1; k < n_elements(); ++k)
+      for (int i = 0; i < 3; ++i) {
+        const Scalar x = feedforward_(k, i) / limits_.limit(i), x2 = x * x, x4 = x2 * x2;
+        e += x4 * x4;
+        max_ratio = std::max(max_ratio, std::abs(x));
+      }
+    return e;
   }
 
   /// Stage 3: final Newton steps (minimum-W-norm step) so the shape meets the target to

@@ -6,7 +6,8 @@
 //   while (!env.done()) { expert.act(torques, S); env.step(torques, S); }
 //
 // Planner: every task is a list of moves "put object i at pose P" (asset frame -> world):
-//   COLL  the object over the container's receptacle, its bottom place_clearance above the rim;
+//   COLL  the object into the container: its bottom place_clearance above the rim, lowered on
+//         into it as far as the fingertips stay finger_clearance above the rim;
 //   ALN   the object at the goal pose (the symmetric equivalent nearest its current yaw);
 //   STK   items[k] onto items[k-1] for k = 1, 2, ... (on the receptacle of the item below, or on
 //         its top), the item below read when the move starts;
@@ -189,6 +190,7 @@ class Expert {
     int object = -1;
     Pose object_target;  ///< asset frame -> world at release
     Pose grasp, place;   ///< end-effector poses
+    double sink = 0;     ///< m the object is lowered into a container below its rim (COLL)
     bool via_approach = false, via_carry = false;
     Pose start;  ///< the end-effector pose the approach leg starts from
     Leg approach_leg, carry_leg;
@@ -275,10 +277,24 @@ class Expert {
     return true;
   }
 
-  /// The carry leg from the grasp to carry_height above the place pose.
+  /// COLL: the object is released low in the container (its bottom place_clearance above the
+  /// floor) rather than dropped from above the rim (a tall one dropped inner_depth rocks on in
+  /// the container for seconds), as far as the fingertips stay finger_clearance above the rim.
+  /// move_goal() puts the object's bottom place_clearance above the rim; this lowers it.
+  void sink_into_container(Plan& p) const {
+    const auto& s = env_->spec();
+    if (s.task != scene::Task::coll) return;
+    const auto& rc = asset_of(s.goal.container).receptacles.at(0);
+    const double rim = (state_of(s.goal.container).pose * rc.opening).translation.z();
+    p.sink = std::clamp(fingertips(p.place).z() - (rim + config_.finger_clearance), 0.0, rc.inner_depth);
+    p.place.translation.z() -= p.sink;
+    p.object_target.translation.z() -= p.sink;
+  }
+
+  /// The carry leg from the grasp to carry_height (plus the sink) above the place pose.
   void set_carry_leg(Plan& p) const {
     Pose above = p.place;
-    above.translation.z() += config_.carry_height;
+    above.translation.z() += config_.carry_height + p.sink;
     p.carry_leg.clear();
     Pose prev = p.grasp;
     if (p.via_carry) {
@@ -404,6 +420,7 @@ class Expert {
             p.object_target = target;
             p.grasp = now * about_axis * g.grasp * half;
             p.place = target * now.inverse() * p.grasp;
+            sink_into_container(p);
             p.via_approach = variant & 1;
             p.via_carry = variant & 2;
             set_approach_leg(p, now * about_axis * approach_pose(g) * half, from);
