@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   app.add_option("--path-cruise", expert_config.path_cruise, "expert: fraction of a path at constant speed (0: quintic timing)")->check(CLI::Range(0.0, 0.95));
   app.add_option("--settle-speed", expert_config.settle_speed, "expert: close / open once the arm's tip is slower, m/s")->check(CLI::PositiveNumber);
   app.add_option("--start-error", expert_config.start_error, "expert: a chained path starts once the previous one is this near its end, m")->check(CLI::PositiveNumber);
+  app.add_option("--via-error", expert_config.via_error, "expert: the same at an intermediate point of a leg (arc or via point), m")->check(CLI::PositiveNumber);
   app.add_option("--place-clearance", expert_config.place_clearance, "expert: the object's bottom above its support when released, m")->check(CLI::NonNegativeNumber);
   app.add_option("--approach-distance", expert_config.approach_distance, "expert: approach pose distance from the grasp, m")->check(CLI::PositiveNumber);
   app.add_option("--settle-error", expert_config.settle_error, "expert: close / open once the end-effector is this near its pose, m")->check(CLI::PositiveNumber);

@@ -73,11 +73,11 @@ struct ExpertConfig {
   double place_clearance = 0.008;   ///< m: the object's bottom above its support when released
   double retract_height = 0.06;     ///< m: up after every release (at least)
   double finger_clearance = 0.02;   ///< m: and until the fingertips are this far above the released object's top
-  double path_peak_speed = 0.9;     ///< m/s, peak end-effector speed of a path's quintic timing (gripper empty)
-  double max_node_speed = 0.9;      ///< m/s, planned peak speed of any rod node (gripper empty)
-  double carry_peak_speed = 0.9;    ///< m/s, the same while an object is held
-  double carry_node_speed = 0.9;    ///< m/s
-  double path_cruise = 0.5;         ///< fraction of a path at constant speed (0: quintic timing; ModelExecutor::track_line)
+  double path_peak_speed = 1.5;     ///< m/s, peak end-effector speed of a path's quintic timing (gripper empty)
+  double max_node_speed = 1.5;      ///< m/s, planned peak speed of any rod node (gripper empty)
+  double carry_peak_speed = 1.2;    ///< m/s, the same while an object is held
+  double carry_node_speed = 1.2;    ///< m/s
+  double path_cruise = 0.7;         ///< fraction of a path at constant speed (0: quintic timing; ModelExecutor::track_line)
   int min_segment_steps = 60;       ///< shortest path, control steps
   double settle_speed = 0.15;       ///< m/s: close / open only when the arm's tip is slower
   double settle_error = 0.01;       ///< m: and the end-effector this near its pose
@@ -87,10 +87,11 @@ struct ExpertConfig {
   double release_lift = 0.0;        ///< m: the stop above where the arm is (release_settle_speed)
   double contact_depth = 0.004;     ///< m: a tall object is lowered until its support carries it: its lower line ends this far below its support
   double retract_peak_speed = 0.9;  ///< m/s: peak end-effector speed of the retract after a release
-  double lower_peak_speed = 0.3;    ///< m/s: peak end-effector speed of the lower line
+  double lower_peak_speed = 0.5;    ///< m/s: peak end-effector speed of the lower line
   double approach_tip_clearance = 0.02;  ///< m: a tall object's approach keeps the open fingertips this far above its top until they straddle it
   double carry_settle_speed = 0.1;  ///< m/s: lower only once the arm's tip is slower at the end of the carry (0: at once)
-  double start_error = 0.015;       ///< m: a chained path starts once the previous one is this near
+  double start_error = 0.03;       ///< m: a chained path starts once the previous one is this near
+  double via_error = 0.05;          ///< m: the same at a leg's intermediate point (an arc or via point: the next line starts from the shape target, the arm catches up)
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
   int max_retries = 1;              ///< re-tries of a missed grasp
@@ -621,7 +622,7 @@ class Expert {
     const bool holding = held && plan_.object >= 0 && *held == env_->bodies().objects[static_cast<std::size_t>(plan_.object)];
     switch (phase_) {
       case ExpertPhase::approach:
-        if (done && error < config_.start_error) {
+        if (done && error < (leg_ + 1 < plan_.approach_leg.count ? config_.via_error : config_.start_error)) {
           if (++leg_ < plan_.approach_leg.count) {
             start_leg(plan_.approach_leg, leg_);
           } else {
@@ -673,7 +674,7 @@ class Expert {
           give_up("dropped the object");
           break;
         }
-        if (done && error < config_.start_error) {
+        if (done && error < (leg_ + 1 < plan_.carry_leg.count ? config_.via_error : config_.start_error)) {
           if (leg_ + 1 < plan_.carry_leg.count) {
             start_leg(plan_.carry_leg, ++leg_);
           } else if (!(config_.carry_settle_speed > 0) || speed < config_.carry_settle_speed || ++waited_ > config_.max_settle_steps) {

@@ -55,7 +55,7 @@ struct TableDesc {
   double half_x = 0.4, half_y = 0.5;  ///< m, of the top
   double thickness = 0.05;            ///< m (the collision box below the top face)
   double friction = 0.6;
-  double rolling_resistance = 5e-4;   ///< m (rigid::RigidBodyDesc::rolling_resistance), also the floor's
+  double rolling_resistance = 1e-3;   ///< m (rigid::RigidBodyDesc::rolling_resistance), also the floor's
   bool add_floor = true;              ///< a static floor at z = 0 catches fallen objects
 };
 
