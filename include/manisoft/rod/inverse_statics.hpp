@@ -424,9 +424,10 @@ class InverseStatics {
   /// Jacobian, steepest descent in the W metric: gradient projection, Liegeois 1977) lowers the
   /// effort E(c) = sum over actuated entries of (tau_ff / limit)^8 (a smooth stand-in for the
   /// largest ratio, gradient by forward differences); Newton steps then return to the target. The
-  /// step's length (Euclidean, in coefficients) grows from 0 at the threshold to relief_step at the limit, so a path's shapes
-  /// change gradually (the continuity check of the executor sees every step). A step is kept only
-  /// if it meets the target and lowers E. Returns the Newton iterations used.
+  /// step's length (Euclidean, in coefficients) grows from 0 at the threshold to relief_step at
+  /// the limit, so a path's shapes change gradually (the executor's continuity check sees every
+  /// step). A step is kept only if it meets the target and lowers E. Returns the Newton
+  /// iterations used.
   int relieve(const Pose& target, Coefficients& c, Residual& r) {
     int used = 0;
     for (int step = 0; step < settings_.relief_iterations; ++step) {

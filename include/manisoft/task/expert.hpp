@@ -91,7 +91,7 @@ struct ExpertConfig {
   double approach_tip_clearance = 0.02;  ///< m: a tall object's approach keeps the open fingertips this far above its top until they straddle it
   double carry_settle_speed = 0.1;  ///< m/s: lower only once the arm's tip is slower at the end of the carry (0: at once)
   double start_error = 0.03;       ///< m: a chained path starts once the previous one is this near
-  double via_error = 0.05;          ///< m: the same at a leg's intermediate point (an arc or via point: the next line starts from the shape target, the arm catches up)
+  double via_error = 0.05;          ///< m: the same at a leg's arc or via point (the next line starts from the shape target; the arm catches up)
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
   int max_retries = 1;              ///< re-tries of a missed grasp
