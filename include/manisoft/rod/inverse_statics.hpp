@@ -473,13 +473,12 @@ class InverseStatics {
     shape(c);
     commit();
     Scalar e = 0;
-    max_ratio = 0;
     for (int k = 1; k < n_elements(); ++k)
       for (int i = 0; i < 3; ++i) {
         const Scalar x = feedforward_(k, i) / limits_.limit(i), x2 = x * x, x4 = x2 * x2;
         e += x4 * x4;
-        max_ratio = std::max(max_ratio, std::abs(x));
       }
+    max_ratio = max_torque_ratio();
     return e;
   }
 

@@ -71,7 +71,7 @@ struct TableSpec {
   Eigen::Vector3d top_center{0.4, 0.0, 0.75};
   double half_x = 0.4, half_y = 0.5, thickness = 0.05;
   double friction = 0.6;
-  double rolling_resistance = 1e-3;  ///< m (world::TableDesc::rolling_resistance)
+  double rolling_resistance = world::TableDesc{}.rolling_resistance;  ///< m
   render::TextureKind texture = render::TextureKind::wood;
   Eigen::Vector3d color{0.55, 0.38, 0.22};            ///< linear RGB of the top
   Eigen::Vector3d secondary_color{0.35, 0.22, 0.12};  ///< texture's second colour

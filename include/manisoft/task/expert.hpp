@@ -610,6 +610,10 @@ class Expert {
     return up;
   }
 
+  /// How near the end of line leg_ of `leg` the arm must be for the next path to start:
+  /// via_error at an arc or via point, start_error at the leg's last pose.
+  double chain_error(const Leg& leg) const { return leg_ + 1 < leg.count ? config_.via_error : config_.start_error; }
+
   /// The phase machine, after the last control step.
   void advance(const TaskEnv::World& w) {
     const auto f = w.soft().end_effector_frame();
@@ -622,7 +626,7 @@ class Expert {
     const bool holding = held && plan_.object >= 0 && *held == env_->bodies().objects[static_cast<std::size_t>(plan_.object)];
     switch (phase_) {
       case ExpertPhase::approach:
-        if (done && error < (leg_ + 1 < plan_.approach_leg.count ? config_.via_error : config_.start_error)) {
+        if (done && error < chain_error(plan_.approach_leg)) {
           if (++leg_ < plan_.approach_leg.count) {
             start_leg(plan_.approach_leg, leg_);
           } else {
@@ -674,7 +678,7 @@ class Expert {
           give_up("dropped the object");
           break;
         }
-        if (done && error < (leg_ + 1 < plan_.carry_leg.count ? config_.via_error : config_.start_error)) {
+        if (done && error < chain_error(plan_.carry_leg)) {
           if (leg_ + 1 < plan_.carry_leg.count) {
             start_leg(plan_.carry_leg, ++leg_);
           } else if (!(config_.carry_settle_speed > 0) || speed < config_.carry_settle_speed || ++waited_ > config_.max_settle_steps) {
