@@ -49,6 +49,9 @@ int main(int argc, char** argv) {
   app.add_option("--settle-speed", expert_config.settle_speed, "expert: close / open once the arm's tip is slower, m/s")->check(CLI::PositiveNumber);
   app.add_option("--start-error", expert_config.start_error, "expert: a chained path starts once the previous one is this near its end, m")->check(CLI::PositiveNumber);
   app.add_option("--via-error", expert_config.via_error, "expert: the same at an intermediate point of a leg (arc or via point), m")->check(CLI::PositiveNumber);
+  app.add_option("--arm-clearance", expert_config.arm_clearance, "expert: the rod clear of objects and obstacles along planned lines, m")->check(CLI::NonNegativeNumber);
+  bool no_arm_check = false;
+  app.add_flag("--no-arm-check", no_arm_check, "expert: do not check planned lines against objects and obstacles");
   app.add_option("--place-clearance", expert_config.place_clearance, "expert: the object's bottom above its support when released, m")->check(CLI::NonNegativeNumber);
   app.add_option("--approach-distance", expert_config.approach_distance, "expert: approach pose distance from the grasp, m")->check(CLI::PositiveNumber);
   app.add_option("--settle-error", expert_config.settle_error, "expert: close / open once the end-effector is this near its pose, m")->check(CLI::PositiveNumber);
@@ -58,6 +61,7 @@ int main(int argc, char** argv) {
   app.add_option("--release-settle-speed", expert_config.release_settle_speed, "expert: a tall object is let go once the arm's tip is slower, m/s")->check(CLI::NonNegativeNumber);
   app.add_option("--lower-speed", expert_config.lower_peak_speed, "expert: peak end-effector speed of the lower line, m/s")->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
+  expert_config.check_arm_clearance = !no_arm_check;
   try {
     const std::clock_t c0 = std::clock();
     scene::SceneSampler sampler;

@@ -9,12 +9,14 @@
 // visual shell's), so things dropped in stay in. Masses come from geometry::mass_properties with
 // an effective density chosen so the mass is realistic for the real object.
 //
-// Grasps (one per object, tool-down, closing along the asset's x axis) are made for the ManiSoft
+// Graspable objects are at most 0.085 m across (a shoe is long along y); the basket is a COLL
+// container as large as a storage basket (20-28 cm square, 7-9 cm tall: every COLL category
+// has instances that stand in one with their centre of mass below the rim) and has no grasp.
+// Grasps (one per graspable object, tool-down, closing along the asset's x axis) are made for the ManiSoft
 // parallel gripper (GraspGripper restates interaction::ParallelGripperParameters' defaults: this
 // layer sits above interaction; tests/assets/test_asset_grasps.cpp checks that they agree): the
 // palm stops palm_clearance above the object's top, but never so low that the fingertips come
-// closer than table_clearance to the support plane (flat objects: plate, bowl, basket, Rubik's
-// cube); the annotated width is the object's extent along the closing axis over the fingers'
+// closer than table_clearance to the support plane (flat objects: plate, bowl, Rubik's cube); the annotated width is the object's extent along the closing axis over the fingers'
 // height range.
 #pragma once
 
@@ -82,6 +84,7 @@ struct Recipe {
   bool on_side = false;
   std::vector<BoxPart> parts{};        ///< non-empty: the asset is these boxes (lathe = false)
   bool long_y = false;                 ///< graspable and longer than 0.085 m along y (a shoe)
+  bool wide = false;                   ///< a container wider than the gripper opens (a basket): no grasp
 };
 
 /// Radius of a profile at height z (linear between points; clamped to the ends).
@@ -229,7 +232,7 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
   Eigen::Vector3d size = r.size * s;
   size.z() *= aspect;
   if (std::string(r.category) == "rubiks_cube") size.z() = size.x();  // a cube
-  if (kind == AssetKind::object) {  // graspable: at most 0.085 across
+  if (kind == AssetKind::object && !r.wide) {  // graspable: at most 0.085 across
     size.x() = std::min(size.x(), 0.085);
     if (!r.long_y) size.y() = std::min(size.y(), 0.085);
   }
@@ -317,7 +320,7 @@ inline Asset build(const Recipe& r, int i, AssetKind kind) {
     a.resting_poses.push_back(RestingPose{Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * 3.14159265358979323846, Eigen::Vector3d::UnitX())),
                                           0.5 * size.x(), "on its side"});
   }
-  if (kind == AssetKind::object) {
+  if (kind == AssetKind::object && !r.wide) {
     const GraspGripper gg;
     GraspAnnotation g;
     math::Matrix3<double> R;
@@ -397,7 +400,7 @@ inline std::vector<Asset> object_catalog() {
       {"plate", true, {{0.7, 0}, {1, 0.8}, {1, 1}}, V(0.085, 0.085, 0.02), 0.08, "ceramic", true},
       {"bowl", true, {{0.5, 0}, {0.85, 0.5}, {1, 1}}, V(0.085, 0.085, 0.05), 0.15, "ceramic", true},
       {"mug", true, {{1, 0}, {1, 1}}, V(0.08, 0.08, 0.095), 0.28, "ceramic", true},
-      {"basket", false, {}, V(0.08, 0.08, 0.06), 0.15, "wood", true},
+      {"basket", false, {}, V(0.24, 0.24, 0.09), 0.4, "wood", true, false, {}, false, true},
   };
   std::vector<Asset> out;
   for (const auto& r : recipes)

@@ -97,6 +97,7 @@ struct ReachInfo {
   int step = 0;                    ///< control steps taken
   bool diverged = false;           ///< the simulated rod refused a step (state kept)
   int clipped = 0;                 ///< element torque entries clamped to the limits in this step
+  double max_node_speed = 0;       ///< m/s, the fastest rod node at any substep of this step
 };
 
 template <template <class> class Damping = rod::damping::AnalyticalLinear,
@@ -176,6 +177,7 @@ class ReachEnv {
     if (!world_) manisoft::detail::fail("ReachEnv::step called before reset");
     action_space_.apply(action, element_torques_);
     info_.clipped = 0;
+    info_.max_node_speed = 0;
     if (!info_.diverged) {
       try {
         info_.clipped = world_->control_step(element_torques_, 0, [this] { record_distance(); });
@@ -289,6 +291,7 @@ class ReachEnv {
   void record_distance() {
     d_history_[d_count_ % config_.stability_window] = reward::pose_error(end_effector(), target_).distance;
     ++d_count_;
+    info_.max_node_speed = std::max(info_.max_node_speed, world_->rod().state().velocities.rowwise().norm().maxCoeff());
   }
 
   void fill_observation() { control::observe_arm(*world_, target_, observation_); }

@@ -1,6 +1,6 @@
 // Scene samplers of the four tasks in the clean and randomized settings (paper sections 3.2,
 // 3.3 and 3.5, figure 4c; issue 12):
-//  COLL  a designated object of one of the paper's 13 categories + a container (basket or bowl);
+//  COLL  a designated object of one of the paper's 13 categories + a container (a basket);
 //  ALN   a bottle, shoe or candle stick + a goal pose (upright, a yaw) on the table;
 //  STK   2-4 bowls or plates of graded size (strictly decreasing width), goal largest first;
 //  ARR   one relation, each kind equally often (left_of, right_of, in_front_of, behind, next_to with
@@ -47,7 +47,7 @@ inline const std::vector<std::string>& coll_categories() {
   return c;
 }
 inline const std::vector<std::string>& coll_containers() {
-  static const std::vector<std::string> c{"basket", "bowl"};
+  static const std::vector<std::string> c{"basket"};
   return c;
 }
 inline const std::vector<std::string>& aln_categories() {
@@ -278,24 +278,24 @@ class SceneSampler {
     return static_cast<int>(s.obstacles.size()) == n;
   }
 
-  /// Whether `obj` fits into `container` with `fit_clearance` to spare: it passes the opening
-  /// and, standing on the floor, its centre of mass stays below the rim, inside the COLL
-  /// predicate's inner volume. Passing the opening: square ones (a basket's straight walls) its
-  /// larger side; round ones (a bowl flares from its floor to the rim) its footprint circle (the
-  /// outer radius less the clearance, which covers the wall). A category none of whose instances
-  /// fits any container (bottles, candle sticks, trophies, shoes) keeps all its instances
-  /// (draw_coll): its scenes cannot be solved.
+  /// Whether `obj` fits into `container` with `fit_clearance` to spare: it stands on the floor
+  /// inside the COLL predicate's inner volume with its centre of mass below the rim. Square
+  /// receptacles (a basket's straight walls): its larger side within the opening's smaller side;
+  /// round ones: its footprint circle within the inner radius (the narrowest, at the floor: a
+  /// bowl that flares holds a wider object higher up, its centre of mass above the rim). Every
+  /// COLL category has instances that fit some basket (the tallest bottles and candle sticks do
+  /// not); draw_coll draws among those.
   bool fits(const assets::Asset& obj, const assets::Asset& container) const {
     if (container.receptacles.empty()) return false;
     const auto& r = container.receptacles.front();
     if (obj.center_of_mass.z() > r.inner_depth) return false;
-    if (r.inner_radius > 0) return footprint_radius(obj) <= container.bounding_half_extents.x() - settings_.fit_clearance;
+    if (r.inner_radius > 0) return footprint_radius(obj) <= r.inner_radius - settings_.fit_clearance;
     return 2 * std::max(obj.bounding_half_extents.x(), obj.bounding_half_extents.y()) <= 2 * r.inner_half_extents.minCoeff() - settings_.fit_clearance;
   }
 
   bool draw_coll(SceneSpec& s, Draw& d) {
     // the category uniformly; within it an instance that fits some container (all instances when
-    // none does: the catalogue's containers are at most 8.5 cm wide)
+    // none does)
     const auto instances = library_.category(d.pick(coll_categories()));
     std::vector<const assets::Asset*> containers;
     for (const auto& c : coll_containers())

@@ -93,6 +93,8 @@ struct ExpertConfig {
   double start_error = 0.03;       ///< m: a chained path starts once the previous one is this near
   double via_error = 0.05;          ///< m: the same at a leg's arc or via point (the next line starts from the shape target; the arm catches up)
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
+  double arm_clearance = 0.01;      ///< m: the rod's surface clear of the other objects' and obstacles' boxes along planned lines
+  bool check_arm_clearance = true;  ///< false: lines are not checked against objects and obstacles (for measuring the check)
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
   int max_retries = 1;              ///< re-tries of a missed grasp
   double approach_distance = 0.06;  ///< m: the approach pose this far from the grasp, along the annotation's approach direction
@@ -280,14 +282,21 @@ class Expert {
 
   /// COLL: the object is released low in the container (its bottom place_clearance above the
   /// floor) rather than dropped from above the rim (a tall one dropped inner_depth rocks on in
-  /// the container for seconds), as far as the fingertips stay finger_clearance above the rim.
+  /// the container for seconds), as far as the fingertips stay finger_clearance above the rim,
+  /// or down to the floor when the open gripper fits into the opening (a basket).
   /// move_goal() puts the object's bottom place_clearance above the rim; this lowers it.
   void sink_into_container(Plan& p) const {
     const auto& s = env_->spec();
     if (s.task != scene::Task::coll) return;
     const auto& rc = asset_of(s.goal.container).receptacles.at(0);
+    // A container whose opening the open gripper fits into (finger_clearance to spare, at any
+    // yaw): the object goes down to its floor.
+    const auto& gp = env_->gripper_parameters();
+    const double reach = std::hypot(std::max(gp.palm_half_x, 0.5 * gp.open_width + gp.finger_thickness), std::max(gp.palm_half_y, gp.finger_half_width));
+    const double room = rc.inner_radius > 0 ? rc.inner_radius : rc.inner_half_extents.minCoeff();
     const double rim = (state_of(s.goal.container).pose * rc.opening).translation.z();
-    p.sink = std::clamp(fingertips(p.place).z() - (rim + config_.finger_clearance), 0.0, rc.inner_depth);
+    p.sink = room >= reach + config_.finger_clearance ? rc.inner_depth
+                                                        : std::clamp(fingertips(p.place).z() - (rim + config_.finger_clearance), 0.0, rc.inner_depth);
     p.place.translation.z() -= p.sink;
     p.object_target.translation.z() -= p.sink;
   }
@@ -440,6 +449,7 @@ class Expert {
     for (int pass = 0; pass < 2; ++pass) {
     repair_ = pass == 1;
     if (repair_ && !config_.ramp_fallback) break;
+    plan_object_ = object;
     for (auto c : candidates) {
       planner_ = executor_;
       planner_.complete_path();
@@ -469,9 +479,14 @@ class Expert {
   bool check_line(const Pose& to, const char*& why) {
     planner_backup_ = planner_;
     const auto report = planner_.track_line(to, 100, std::numeric_limits<double>::infinity(), config_.path_cruise);
+    bool clear = true;
+    for (int k = 1; k <= line_samples && report.accepted && clear; ++k) {
+      planner_.predicted_shape(100 * k / line_samples, shape_);
+      clear = arm_clear(shape_);
+    }
     planner_.complete_path();
-    if (!report.accepted) {
-      why = report.reason;
+    if (!report.accepted || !clear) {
+      why = report.accepted ? "the arm would hit an object or obstacle" : report.reason;
       planner_ = planner_backup_;
       return false;
     }
@@ -483,13 +498,37 @@ class Expert {
     return true;
   }
 
+  /// Whether a shape of the arm (rod nodes, the tip's but the gripper's) keeps the rod's surface
+  /// arm_clearance clear of the bounding box of every object but the moved one (as they stand
+  /// now) and of every obstacle: a node hits a box when, in the box's frame, it is within its
+  /// half extents plus the rod radius and clearance horizontally and below its top plus them.
+  bool arm_clear(const Array3& positions) const {
+    if (!config_.check_arm_clearance) return true;
+    const double margin = std::sqrt(env_->arm_model().rod.cross_section_area.maxCoeff() / std::numbers::pi) + config_.arm_clearance;
+    const auto& s = env_->spec();
+    auto hits = [&](const Pose& pose, const assets::Asset& a) {
+      for (Eigen::Index j = 0; j + 1 < positions.rows(); ++j) {
+        const Vec3 q = pose.inverse_act(Vec3(positions.row(j).transpose())) - a.bounding_center;
+        const Vec3& h = a.bounding_half_extents;
+        if (std::abs(q.x()) < h.x() + margin && std::abs(q.y()) < h.y() + margin && q.z() < h.z() + margin && q.z() > -h.z() - margin) return true;
+      }
+      return false;
+    };
+    for (std::size_t i = 0; i < s.objects.size(); ++i)
+      if (static_cast<int>(i) != plan_object_ && hits(state_of(static_cast<int>(i)).pose, asset_of(static_cast<int>(i)))) return false;
+    for (const auto& o : s.obstacles)
+      if (hits(o.pose, env_->library().get(o.asset_id, "expert obstacle"))) return false;
+    return true;
+  }
+
   /// Checks a ramp to `to` on planner_ (the cold inverse statics solution within the limits and
   /// clear of the table) and jumps to its end; false (the planner as before) otherwise.
   bool check_ramp(const Pose& to) {
     planner_backup_ = planner_;
     const auto r = planner_.set_target(to);
     planner_.complete_path();
-    if (r.within_limits && planner_.statics().desired_state().positions.col(2).minCoeff() >= env_->spec().table.top_center.z() + config_.table_clearance) return true;
+    const auto& end = planner_.statics().desired_state().positions;
+    if (r.within_limits && end.col(2).minCoeff() >= env_->spec().table.top_center.z() + config_.table_clearance && arm_clear(end)) return true;
     planner_ = planner_backup_;
     return false;
   }
@@ -739,6 +778,9 @@ class Expert {
   const TaskEnv* env_;
   ExpertConfig config_;
   Executor executor_, planner_, planner_backup_;
+  static constexpr int line_samples = 8;  ///< shapes checked along a planned line (arm_clear)
+  Array3 shape_;
+  int plan_object_ = -1;
   control::Observation<double> observation_;
   Pose target_;
   Plan plan_;
