@@ -2,7 +2,8 @@
 // 3.3 and 3.5, figure 4c; issue 12):
 //  COLL  a designated object of one of the paper's 13 categories + a container (a basket);
 //  ALN   a bottle, shoe or candle stick + a goal pose (upright, a yaw) on the table;
-//  STK   2-4 bowls or plates of graded size (strictly decreasing width), goal largest first;
+//  STK   2-4 bowls or plates of graded size (strictly decreasing width) within stk_spread of the
+//        largest (a set of dishes), goal largest first;
 //  ARR   one relation, each kind equally often (left_of, right_of, in_front_of, behind, next_to with
 //        2-3 objects; between, in_a_row with 3) among Rubik's cube / bottle / pen cup / shoe, and a
 //        free spot for it.
@@ -72,6 +73,7 @@ struct SamplerSettings {
   double min_goal_distance = 0.12;  ///< m: an ALN goal / ARR spot this far from the start at least
   double relation_distance = 0.15;  ///< m between an ARR object and its reference
   double fit_clearance = 0.004;     ///< m: a COLL object is this much narrower than the opening
+  double stk_spread = 0.3;          ///< m: STK items lie within this distance of the bottom one (a set of dishes)
   geometry::RelationTolerances relations;  ///< ARR: the success predicate's margins
   double relation_margin = 0.02;    ///< m: the ARR spot holds with margins this much tighter, the start fails with them this much wider
   int min_obstacles = 3, max_obstacles = 10;
@@ -189,13 +191,18 @@ class SceneSampler {
   /// A free point of the reachable area (ReachBand) at grasp height h for a footprint of radius
   /// r of something `height` tall (clear_of_home): uniform over the table, kept when inside the band
   /// (rejection sampling).
-  std::optional<Eigen::Vector2d> reachable_spot(const SceneSpec& s, Draw& d, double h, double r, double height = 0) {
+  /// A free reachable spot on the table (uniform over the table, or over the disc of radius
+  /// `spread` about `near` when given).
+  std::optional<Eigen::Vector2d> reachable_spot(const SceneSpec& s, Draw& d, double h, double r, double height = 0,
+                                                const Eigen::Vector2d* near = nullptr, double spread = 0) {
     const auto& b = settings_.band;
-    const Eigen::Vector2d c = s.table.top_center.head<2>();
+    const Eigen::Vector2d c = near ? *near : s.table.top_center.head<2>();
+    const double hx = near ? spread : s.table.half_x, hy = near ? spread : s.table.half_y;
     for (int t = 0; t < settings_.placement_tries; ++t) {
-      const double px = d.uniform(c.x() - s.table.half_x, c.x() + s.table.half_x);  // one draw per statement: the
-      const double py = d.uniform(c.y() - s.table.half_y, c.y() + s.table.half_y);  // order of arguments is unspecified
+      const double px = d.uniform(c.x() - hx, c.x() + hx);  // one draw per statement: the
+      const double py = d.uniform(c.y() - hy, c.y() + hy);  // order of arguments is unspecified
       const Eigen::Vector2d p(px, py);
+      if (near && (p - c).norm() > spread) continue;
       if (b.contains(p, h) && on_table(s, p, r) && free(p, r) && clear_of_home(p, r, height)) return p;
     }
     return std::nullopt;
@@ -211,10 +218,12 @@ class SceneSampler {
     pose.translation = Eigen::Vector3d(p.x(), p.y(), top + a.resting_poses.front().height);
     return pose;
   }
-  /// Places asset `a` in the reachable band at height h; returns its object index or -1.
-  int place_object(SceneSpec& s, Draw& d, const assets::Asset& a, double h, bool grasped) {
+  /// Places asset `a` in the reachable band at height h (within `spread` of `near` when given);
+  /// returns its object index or -1.
+  int place_object(SceneSpec& s, Draw& d, const assets::Asset& a, double h, bool grasped, const Eigen::Vector2d* near = nullptr,
+                   double spread = 0) {
     const double r = keepout(a, grasped);
-    const auto p = reachable_spot(s, d, h, r, asset_height(a));
+    const auto p = reachable_spot(s, d, h, r, asset_height(a), near, spread);
     if (!p) return -1;
     PlacedAsset o;
     o.asset_id = a.id;
@@ -371,7 +380,9 @@ class SceneSampler {
       if (k == 0) {
         for (std::size_t j = 0; j < chosen.size(); ++j) stack += asset_height(*chosen[j]);
       }
-      const int i = place_object(s, d, *a, k == 0 ? stack - asset_height(*chosen.back()) + grasp_height(*chosen.back()) + settings_.validation.place_clearance : h, true);
+      const Eigen::Vector2d bottom = k == 0 ? Eigen::Vector2d::Zero() : Eigen::Vector2d(s.objects[static_cast<std::size_t>(s.goal.items.front())].pose.translation.head<2>());
+      const int i = place_object(s, d, *a, k == 0 ? stack - asset_height(*chosen.back()) + grasp_height(*chosen.back()) + settings_.validation.place_clearance : h, true,
+                                 k == 0 ? nullptr : &bottom, settings_.stk_spread);
       if (i < 0) return false;
       s.goal.items.push_back(i);
     }
