@@ -169,6 +169,43 @@ TEST_CASE("an expert episode is deterministic: two runs give bit-identical state
   CHECK((a.second.array() == b.second.array()).all());
 }
 
+TEST_CASE("the expert does not plan the arm through an obstacle in its way", "[tasks][expert]") {
+  // ALN clean 6: the bottle at (0.29, 0.33), 0.4 m from the home pose; a vase (12 cm wide, 21 cm
+  // tall) halfway between them, 0.2 m from each, under the arm's way to the bottle. With the
+  // check the expert refuses every plan (no detour around it is planned) and the arm never
+  // touches the vase; without it, the arm runs into it.
+  SceneSpec s = sample(Task::aln, 6);
+  const Eigen::Vector3d object = s.objects.at(static_cast<std::size_t>(s.goal.object)).pose.translation;
+  PlacedAsset vase;
+  vase.asset_id = "vase/00";
+  vase.pose.translation = Eigen::Vector3d(0.5 + 0.5 * (object.x() - 0.5), 0.5 * object.y(), s.table.top_center.z());
+  s.obstacles.push_back(vase);
+  for (const bool check : {true, false}) {
+    CAPTURE(check);
+    manisoft::task::ExpertConfig config;
+    config.check_arm_clearance = check;
+    TaskEnv& e = env();
+    Expert expert(e, config);
+    e.reset(s);
+    expert.reset();
+    TaskEnv::Array3 torques;
+    int gripper = 0;
+    while (!e.done()) {
+      expert.act(torques, gripper);
+      e.step(torques, gripper);
+    }
+    const std::string why = expert.failure() ? expert.failure() : "";
+    CAPTURE(why, manisoft::task::to_string(e.info().failure));
+    CHECK_FALSE(e.info().success);
+    if (check) {
+      CHECK(why.find("the arm would hit an object or obstacle") != std::string::npos);
+      CHECK(e.info().failure == FailureReason::timeout);
+    } else {
+      CHECK(e.info().failure == FailureReason::arm_hit_obstacle);
+    }
+  }
+}
+
 TEST_CASE("the expert solves fixed clean scenes within the horizon", "[tasks][expert]") {
   // Scenes the expert solves today (the README's table gives its rate over many scenes).
   const std::pair<Task, std::uint64_t> scenes[] = {{Task::coll, 0}, {Task::aln, 1}, {Task::aln, 9}, {Task::arr, 13}};

@@ -7,7 +7,8 @@
 //
 // Planner: every task is a list of moves "put object i at pose P" (asset frame -> world):
 //   COLL  the object into the container: its bottom place_clearance above the rim, lowered on
-//         into it as far as the fingertips stay finger_clearance above the rim;
+//         into it as far as the fingertips stay finger_clearance above the rim (down to the
+//         floor when the open gripper fits into the opening: the basket);
 //   ALN   the object at the goal pose (the symmetric equivalent nearest its current yaw);
 //   STK   items[k] onto items[k-1] for k = 1, 2, ... (on the receptacle of the item below, or on
 //         its top), the item below read when the move starts;
@@ -17,8 +18,11 @@
 // (the parallel gripper is symmetric) and turned about the object's axis as its symmetry allows
 // (round: eighth turns, square: quarter turns), the one whose grasp and place end-effector poses
 // turn least from the home pose, whose whole sequence the executor accepts (continuous shapes
-// within the actuation limits, the payload included) and whose waypoint shapes keep every rod
-// node table_clearance above the table top.
+// within the actuation limits, the payload included), whose waypoint shapes keep every rod
+// node table_clearance above the table top, and along whose lines (line_samples shapes each)
+// the rod keeps arm_clearance from the bounding box of every obstacle and every object but the
+// moved one (arm_clear; the gripper and the held object are not checked). No detour around an
+// obstacle is planned: a move with no clear candidate is given up.
 // Waypoints of a move (the end-effector frame; straight lines with quintic timing, or a cruise
 // at constant speed over path_cruise of the line: ModelExecutor::track_line): approach (along
 // the annotation's approach direction, approach_distance from the grasp; "via": first level to
