@@ -18,9 +18,10 @@
 // control values with zero ends, Elastica-RL's layout). The model
 // executor drives the B-spline space through ProjectedExecutor (least-squares fit of its element
 // torques); an MLP's network must output rows x 3 values of the chosen space.
-// Also reported per target (the transients a success rate hides): the fastest rod node at any substep (m/s) and the tip path ratio, the end-effector's path from
-// the start to the first step of the held window (to the horizon if none) over the straight
-// distance from its start position to the target.
+// Also reported per target (the transients a success rate hides): the fastest rod node at any
+// substep (m/s) and the tip path ratio, the end-effector's path from the end of the first control
+// step to the first step of the held window (to the horizon if none) over the straight distance
+// from there to the target.
 #include <chrono>
 #include <cmath>
 #include <cstdio>

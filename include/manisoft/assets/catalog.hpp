@@ -12,12 +12,13 @@
 // Graspable objects are at most 0.085 m across (a shoe is long along y); the basket is a COLL
 // container as large as a storage basket (20-28 cm square, 7-9 cm tall: every COLL category
 // has instances that stand in one with their centre of mass below the rim) and has no grasp.
-// Grasps (one per graspable object, tool-down, closing along the asset's x axis) are made for the ManiSoft
-// parallel gripper (GraspGripper restates interaction::ParallelGripperParameters' defaults: this
+// Grasps (one per graspable object, tool-down, closing along the asset's x axis) are made for the
+// ManiSoft parallel gripper (GraspGripper restates interaction::ParallelGripperParameters' defaults: this
 // layer sits above interaction; tests/assets/test_asset_grasps.cpp checks that they agree): the
 // palm stops palm_clearance above the object's top, but never so low that the fingertips come
-// closer than table_clearance to the support plane (flat objects: plate, bowl, Rubik's cube); the annotated width is the object's extent along the closing axis over the fingers'
-// height range.
+// closer than table_clearance to the support plane (flat objects: plate, bowl, Rubik's cube);
+// the annotated width is the object's extent along the closing axis over the fingers' height
+// range.
 #pragma once
 
 #include <Eigen/Core>

@@ -189,10 +189,8 @@ class SceneSampler {
     return height <= settings_.home_clear_height || (p - settings_.home_xy).norm() >= r + settings_.home_keepout;
   }
   /// A free point of the reachable area (ReachBand) at grasp height h for a footprint of radius
-  /// r of something `height` tall (clear_of_home): uniform over the table, kept when inside the band
-  /// (rejection sampling).
-  /// A free reachable spot on the table (uniform over the table, or over the disc of radius
-  /// `spread` about `near` when given).
+  /// r of something `height` tall (clear_of_home): uniform over the table (or over the disc of
+  /// radius `spread` about `near` when given), kept when inside the band (rejection sampling).
   std::optional<Eigen::Vector2d> reachable_spot(const SceneSpec& s, Draw& d, double h, double r, double height = 0,
                                                 const Eigen::Vector2d* near = nullptr, double spread = 0) {
     const auto& b = settings_.band;

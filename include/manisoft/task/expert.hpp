@@ -450,10 +450,10 @@ class Expert {
     std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
     plan_refusal_ = candidates.empty() ? "the asset has no grasp annotation" : "";
     // first pass: straight lines only; second: refused lines repaired (check_leg)
+    plan_object_ = object;
     for (int pass = 0; pass < 2; ++pass) {
     repair_ = pass == 1;
     if (repair_ && !config_.ramp_fallback) break;
-    plan_object_ = object;
     for (auto c : candidates) {
       planner_ = executor_;
       planner_.complete_path();
@@ -502,10 +502,10 @@ class Expert {
     return true;
   }
 
-  /// Whether a shape of the arm (rod nodes, the tip's but the gripper's) keeps the rod's surface
-  /// arm_clearance clear of the bounding box of every object but the moved one (as they stand
-  /// now) and of every obstacle: a node hits a box when, in the box's frame, it is within its
-  /// half extents plus the rod radius and clearance horizontally and below its top plus them.
+  /// Whether a shape of the arm (every rod node but the tip, which sits in the palm) keeps the
+  /// rod's surface arm_clearance clear of the bounding box of every object but the moved one (as
+  /// they stand now) and of every obstacle: a node hits a box when, in the box's frame, it is
+  /// within the half extents plus the rod radius and clearance on every axis.
   bool arm_clear(const Array3& positions) const {
     if (!config_.check_arm_clearance) return true;
     const double margin = std::sqrt(env_->arm_model().rod.cross_section_area.maxCoeff() / std::numbers::pi) + config_.arm_clearance;
