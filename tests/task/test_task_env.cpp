@@ -38,6 +38,18 @@ SceneSpec sample(Task t, std::uint64_t index) {
   return sampler().sample(q);
 }
 
+/// Runs `expert` on `e` from scene `s` for at most `max_steps` control steps (or until done).
+void run_expert(TaskEnv& e, Expert& expert, const SceneSpec& s, int max_steps = 100000) {
+  e.reset(s);
+  expert.reset();
+  TaskEnv::Array3 torques;
+  int gripper = 0;
+  for (int i = 0; i < max_steps && !e.done(); ++i) {
+    expert.act(torques, gripper);
+    e.step(torques, gripper);
+  }
+}
+
 /// Holds the arm at home (a copy of the executor that brought it there) until the episode ends.
 void hold_home(TaskEnv& e, int max_steps = 100000) {
   TaskEnv::Executor hold = e.home_executor();
@@ -154,14 +166,7 @@ TEST_CASE("an expert episode is deterministic: two runs give bit-identical state
   auto run = [&](int steps) {
     TaskEnv& e = env();
     Expert expert(e);
-    e.reset(s);
-    expert.reset();
-    TaskEnv::Array3 torques;
-    int gripper = 0;
-    for (int i = 0; i < steps && !e.done(); ++i) {
-      expert.act(torques, gripper);
-      e.step(torques, gripper);
-    }
+    run_expert(e, expert, s, steps);
     return std::make_pair(e.world().rod().state().positions, e.snapshot().objects[0].pose.translation);
   };
   const auto a = run(400), b = run(400);
@@ -186,14 +191,7 @@ TEST_CASE("the expert does not plan the arm through an obstacle in its way", "[t
     config.check_arm_clearance = check;
     TaskEnv& e = env();
     Expert expert(e, config);
-    e.reset(s);
-    expert.reset();
-    TaskEnv::Array3 torques;
-    int gripper = 0;
-    while (!e.done()) {
-      expert.act(torques, gripper);
-      e.step(torques, gripper);
-    }
+    run_expert(e, expert, s);
     const std::string why = expert.failure() ? expert.failure() : "";
     CAPTURE(why, manisoft::task::to_string(e.info().failure));
     CHECK_FALSE(e.info().success);
@@ -214,14 +212,7 @@ TEST_CASE("the expert solves fixed clean scenes within the horizon", "[tasks][ex
     CAPTURE(to_string(t), index);
     TaskEnv& e = env();
     Expert expert(e);
-    e.reset(sample(t, index));
-    expert.reset();
-    TaskEnv::Array3 torques;
-    int gripper = 0;
-    while (!e.done()) {
-      expert.act(torques, gripper);
-      e.step(torques, gripper);
-    }
+    run_expert(e, expert, sample(t, index));
     CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure));
     if (e.info().success) {
       ++solved;

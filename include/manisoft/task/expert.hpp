@@ -139,7 +139,8 @@ class Expert {
   using Executor = TaskEnv::Executor;
 
   explicit Expert(const TaskEnv& env, ExpertConfig config = {})
-      : env_(&env), config_(config), executor_(env.home_executor()), planner_(env.home_executor()), planner_backup_(env.home_executor()) {
+      : env_(&env), config_(config), executor_(env.home_executor()), planner_(env.home_executor()), planner_backup_(env.home_executor()),
+        arm_margin_(std::sqrt(env.arm_model().rod.cross_section_area.maxCoeff() / std::numbers::pi) + config.arm_clearance) {
     const int n = env.arm_model().rod.n_elements;
     observation_ = control::make_arm_observation<double>(n, env.config().observe_stride);
     events_.reserve(64);
@@ -508,13 +509,11 @@ class Expert {
   /// within the half extents plus the rod radius and clearance on every axis.
   bool arm_clear(const Array3& positions) const {
     if (!config_.check_arm_clearance) return true;
-    const double margin = std::sqrt(env_->arm_model().rod.cross_section_area.maxCoeff() / std::numbers::pi) + config_.arm_clearance;
     const auto& s = env_->spec();
     auto hits = [&](const Pose& pose, const assets::Asset& a) {
       for (Eigen::Index j = 0; j + 1 < positions.rows(); ++j) {
         const Vec3 q = pose.inverse_act(Vec3(positions.row(j).transpose())) - a.bounding_center;
-        const Vec3& h = a.bounding_half_extents;
-        if (std::abs(q.x()) < h.x() + margin && std::abs(q.y()) < h.y() + margin && q.z() < h.z() + margin && q.z() > -h.z() - margin) return true;
+        if ((q.cwiseAbs() - a.bounding_half_extents).maxCoeff() < arm_margin_) return true;
       }
       return false;
     };
@@ -783,6 +782,7 @@ class Expert {
   ExpertConfig config_;
   Executor executor_, planner_, planner_backup_;
   static constexpr int line_samples = 8;  ///< shapes checked along a planned line (arm_clear)
+  double arm_margin_;                      ///< m: the rod's radius + arm_clearance (arm_clear)
   Array3 shape_;
   int plan_object_ = -1;
   control::Observation<double> observation_;
