@@ -2,16 +2,19 @@
 // stiffness estimate and outer-loop re-solves amortized as they occur), the per-target set-up
 // (cold inverse statics from the start library) on both target sets, and its one-time
 // construction. The step benchmark runs on both action spaces (element torques; 8 B-spline
-// control values per direction through ProjectedExecutor's least-squares projection).
+// control values per direction through ProjectedExecutor's least-squares projection), and the
+// path set-up of trajectory tracking (track_line) on the pick-and-place paths.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <vector>
 
 #include "manisoft/control/mlp_executor.hpp"
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/control/projected_executor.hpp"
+#include "manisoft/env/pick_place.hpp"
 #include "manisoft/env/reach_env.hpp"
 
 namespace {
@@ -70,6 +73,41 @@ void BM_ModelExecutorSetup(benchmark::State& state) {
   state.counters["max_us"] = slowest;
 }
 BENCHMARK(BM_ModelExecutorSetup)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->Iterations(300);
+
+/// Path set-up (track_line, issue 10): the pick-and-place paths of 50 tasks (pre-grasp, grasp,
+/// carry, place), each planned from the end of the one before, the first from the settled home
+/// shape, with the held cube's payload from the carry on, as env::PickPlaceRunner plans them. The
+/// knots' inverse statics (with actuator relief) and the continuity checks. Also reports the
+/// slowest single set-up (max_us, wall).
+void BM_TrackLineSetup(benchmark::State& state) {
+  manisoft::env::PickPlaceRunner runner;
+  std::vector<std::array<manisoft::math::Pose<double>, 4>> paths;
+  std::vector<Eigen::Vector3d> in_hand;
+  for (std::uint64_t s = 0; s < 50; ++s) {
+    const auto task = runner.draw_task(100000 + s);
+    paths.push_back(runner.waypoints(task, Eigen::Vector3d::Zero()));
+    in_hand.push_back(paths.back()[1].rotation.transpose() * (task.object - paths.back()[1].translation));
+  }
+  manisoft::control::ModelExecutor<double> executor = runner.home_executor();
+  std::size_t i = 0;
+  double slowest = 0;
+  for (auto _ : state) {
+    const std::size_t task = (i / 4) % paths.size(), leg = i % 4;
+    if (leg == 0 || leg == 2) {
+      state.PauseTiming();
+      if (leg == 0) executor = runner.home_executor();
+      if (leg == 2) executor.set_payload(runner.config().object_mass, in_hand[task]);
+      state.ResumeTiming();
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(executor.track_line(paths[task][leg], 100));
+    slowest = std::max(slowest, std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+    executor.complete_path();
+    ++i;
+  }
+  state.counters["max_us"] = slowest;
+}
+BENCHMARK(BM_TrackLineSetup)->Unit(benchmark::kMicrosecond)->Iterations(800);
 
 /// One-time construction of the model executor (its inverse statics builds the start library).
 void BM_ModelExecutorConstruct(benchmark::State& state) {

@@ -1,7 +1,7 @@
 // pick_place_eval: the model executor as a trajectory tracker on a tabletop pick and place
 // (issue 10; the routine is env::PickPlaceRunner, include/manisoft/env/pick_place.hpp).
 //
-//   pick_place_eval --episodes N --seed S [--mass KG] --out FILE.csv
+//   pick_place_eval --episodes N --seed S [--mass KG] [--object cube|can] --out FILE.csv
 //
 // Episode i uses seed S * 100000 + i. Prints one table row per episode as it goes, then a last
 // line of JSON:
@@ -27,22 +27,24 @@ int main(int argc, char** argv) {
   int episodes = 20;
   long seed = 1;
   double mass = 0.1;
-  std::string out;
+  std::string object = "cube", out;
   app.add_option("--episodes", episodes, "episodes to run")->required()->check(CLI::Range(1, 1000000));
   app.add_option("--seed", seed, "seed of the task set (episode i: seed * 100000 + i)")->required()->check(CLI::Range(0L, 1000000000L));
-  app.add_option("--mass", mass, "cube mass, kg (default 0.1)")->check(CLI::Range(0.001, 5.0));
+  app.add_option("--mass", mass, "object mass, kg (default 0.1)")->check(CLI::Range(0.001, 5.0));
+  app.add_option("--object", object, "cube (5 cm) or can (r 3.3 cm, lying on its side)")->check(CLI::IsMember({"cube", "can"}));
   app.add_option("--out", out, "per-episode CSV")->required();
   CLI11_PARSE(app, argc, argv);
   try {
     std::ofstream csv(out);
     if (!csv) manisoft::detail::fail("pick_place_eval: cannot write '", out, "'");
     csv << "episode,seed,success,failure,steps,cpu_s,executor_s,max_setup_s,max_node_speed,max_path_ratio,max_planned_ratio,"
-           "place_error,tilt,grasp_step,release_step,cube_x,cube_y,cube_yaw,place_x,place_y\n";
+           "place_error,tilt,grasp_step,release_step,object_x,object_y,object_yaw,place_x,place_y\n";
     csv.precision(9);
     manisoft::env::PickPlaceConfig config;
-    config.cube_mass = mass;
+    config.object_mass = mass;
+    config.object = object == "can" ? manisoft::env::PickPlaceObject::can : manisoft::env::PickPlaceObject::cube;
     manisoft::env::PickPlaceRunner runner(config);
-    std::printf("pick and place: %d episodes, seed %ld, cube %.3f kg (home reset: %d control steps, not counted)\n", episodes, seed, mass,
+    std::printf("pick and place: %d episodes, seed %ld, %s %.3f kg (home reset: %d control steps, not counted)\n", episodes, seed, object.c_str(), mass,
                 runner.home_steps());
     std::printf("%7s %8s %-13s %6s %7s %9s %8s %8s %9s\n", "episode", "success", "failure", "steps", "cpu_s", "node_m/s", "path_ratio",
                 "err_mm", "setup_ms");
@@ -68,7 +70,7 @@ int main(int argc, char** argv) {
       csv << i << ',' << s << ',' << int(r.success) << ',' << (r.success ? "" : r.failure) << ',' << r.steps << ',' << r.cpu_seconds << ','
           << r.executor_seconds << ',' << r.max_setup_seconds << ',' << r.max_node_speed << ',' << r.max_path_ratio << ','
           << r.max_planned_ratio << ',' << r.place_error << ',' << r.tilt << ',' << r.grasp_step << ',' << r.release_step << ','
-          << r.task.cube.x() << ',' << r.task.cube.y() << ',' << r.task.cube_yaw << ',' << r.task.place.x() << ',' << r.task.place.y()
+          << r.task.object.x() << ',' << r.task.object.y() << ',' << r.task.object_yaw << ',' << r.task.place.x() << ',' << r.task.place.y()
           << '\n';
     }
     if (!csv.flush()) manisoft::detail::fail("pick_place_eval: writing '", out, "' failed");

@@ -241,7 +241,9 @@ TEST_CASE("pick and place: a few episodes succeed within the step and speed boun
     CHECK(r.steps <= 1500);
     CHECK(r.max_node_speed < 1.5);
     CHECK(r.max_path_ratio <= 1.5);
-    CHECK(r.place_error < 0.02);
+    // The success bound is 2 cm; lowered at 0.3 m/s the cube lands within 1 cm (lowered at 0.9 m/s
+    // the arm swung and these three landed 12-15 mm off).
+    CHECK(r.place_error < 0.01);
     CHECK(r.grasp_step > 0);
     CHECK(r.release_step > r.grasp_step);
     // The same seed in another runner (and after other episodes) gives the same episode, bit for bit.
@@ -250,9 +252,24 @@ TEST_CASE("pick and place: a few episodes succeed within the step and speed boun
     CHECK(again.place_error == r.place_error);
     CHECK(again.max_node_speed == r.max_node_speed);
   }
+  // A can lying on its side, grasped across its axis: set down within 1 cm, its axis still
+  // horizontal (5 deg), within the horizon.
+  manisoft::env::PickPlaceConfig can_config;
+  can_config.object = manisoft::env::PickPlaceObject::can;
+  manisoft::env::PickPlaceRunner can_runner(can_config);
+  for (std::uint64_t seed : {100000u, 100001u}) {
+    const auto r = can_runner.run(seed);
+    CAPTURE(seed, r.failure, r.detail, r.steps, r.place_error, r.tilt, r.task.gripper_yaw);
+    CHECK(r.success);
+    CHECK(r.steps <= 1500);
+    CHECK(r.place_error < 0.01);
+    CHECK(r.tilt < 5 * std::numbers::pi / 180);
+    // The fingers closed across the axis: the gripper's closing axis (yaw) is a quarter turn off it.
+    CHECK(std::abs(std::cos(r.task.gripper_yaw - r.task.object_yaw)) < 1e-12);
+  }
   manisoft::env::PickPlaceConfig bad;
-  bad.cube_mass = -1;
-  CHECK_THROWS_WITH(manisoft::env::PickPlaceRunner(bad), Catch::Contains("cube_mass"));
+  bad.object_mass = -1;
+  CHECK_THROWS_WITH(manisoft::env::PickPlaceRunner(bad), Catch::Contains("object_mass"));
 }
 
 }  // namespace test_tracking

@@ -8,27 +8,31 @@
 // World: world::ArmWorld on the tabletop scene (table, floor, the arm mounted at (-0.05, 0, 1.5)
 // pointing +x, the parallel gripper on the arm coupling), rod damping analytical 0.1 and the
 // coupling both the executor's validated defaults (the reach environment's), 7 substeps of 2e-4 s
-// per control step (714 Hz), rod contact on. One cube (5 cm, `cube_mass`) on the table.
+// per control step (714 Hz), rod contact on. One object of `object_mass` on the table: a 5 cm
+// cube, or a can (r 3.3 cm, 11.6 cm long) lying on its side (`PickPlaceConfig::object`).
 // Home: every episode starts from the same settled state, the gripper tool-down with its grasp
 // centre at `home` (reached once from the straight arm by the executor's shape ramp; those reset steps are
 // not the episode's and are reported apart: home_steps()).
-// Task of a seed (draw_task; std::mt19937_64 raw output, own uniform): cube centre uniform in
+// Task of a seed (draw_task; std::mt19937_64 raw output, own uniform): object centre uniform in
 // the reachable band x in [0.30, 0.62], y in [-0.25, 0.25], yaw uniform; place point 15-25 cm away
 // in a uniform direction, in the same band; redrawn until every path, planned from the home shape,
 // needs at most plan_torque_ratio of the actuation limits (headroom for the shape the outer loop
 // and the payload leave at run time) and every waypoint shape is 6 cm clear of the table top.
-// Waypoints (gripper tool-down, yaw = the cube's yaw folded into [-45, 45] deg, constant along the
-// episode): pre-grasp (grasp + pregrasp_height), grasp (grasp centre grasp_height above the table
-// top: fingertips 1 cm above it), carry (above the place point, carry_height higher; a diagonal
-// line from the grasp), place (corrected for where the cube sits in the hand, its bottom
-// place_clearance above the top). Every move is executor.track_line (straight line, quintic
-// timing, duration from path_peak_speed, at least min_segment_steps). The gripper closes only
-// when the arm has settled (every node slower than settle_speed, end-effector within settle_error
-// of the grasp pose; at most max_settle_steps of waiting), then tells the executor its payload
-// (mass and offset in the hand); it opens once settled at the place pose.
-// Success: the cube released (not held), its centre within success_distance (2 cm) of the place
-// point horizontally, flat (a face axis within 5 deg of vertical) and at rest (< 1 cm/s,
-// < 0.1 rad/s for rest_steps control steps), within max_steps control steps.
+// Waypoints (gripper tool-down, constant yaw along the episode: the cube's yaw folded into
+// [-45, 45] deg, or across the can's axis folded into [-90, 90] deg): pre-grasp (grasp +
+// pregrasp_height), grasp (grasp centre grasp_height above the table top: fingertips 1 cm above
+// it), carry (above the place point, carry_height higher; a diagonal line from the grasp), place
+// (corrected for where the object sits in the hand, its bottom place_clearance above the top).
+// Every move is executor.track_line (straight line, quintic timing, duration from
+// path_peak_speed, lower_peak_speed for the last, at least min_segment_steps). The gripper closes
+// only when the arm has settled (every node slower than settle_speed, end-effector within
+// settle_error of the grasp pose; at most max_settle_steps of waiting), then tells the executor
+// its payload (mass and offset in the hand); it opens once the table carries the object, or once
+// settled at the place pose.
+// Success: the object released (not held), its centre within success_distance (2 cm) of the place
+// point horizontally, flat (a cube: a face axis within 5 deg of vertical; a can: its axis within
+// 5 deg of horizontal) and at rest (< 1 cm/s, < 0.1 rad/s for rest_steps control steps), within
+// max_steps control steps.
 // Failure reasons: path_refused, missed_grasp, dropped, timeout, diverged, off_target, tilted.
 #pragma once
 
@@ -54,9 +58,17 @@
 
 namespace manisoft::env {
 
+/// What is picked and placed: a cube, or a can lying on its side (a cylinder whose axis is
+/// horizontal; grasped across its axis, so the gripper's closing axis is perpendicular to it).
+enum class PickPlaceObject { cube, can };
+
 struct PickPlaceConfig {
-  double cube_mass = 0.1;              ///< kg
+  PickPlaceObject object = PickPlaceObject::cube;
+  double object_mass = 0.1;            ///< kg
   double cube_half = 0.025;            ///< m
+  double can_radius = 0.033;           ///< m (a 330 ml drinks can)
+  double can_half_length = 0.058;      ///< m
+  double can_rolling_resistance = 5e-4;  ///< m, as every asset (a bare cube keeps 0)
   double dt = 2e-4;                    ///< s
   int substeps = 7;                    ///< per control step (714 Hz)
   int max_steps = 1500;                ///< control steps per episode (the paper's horizon)
@@ -68,8 +80,10 @@ struct PickPlaceConfig {
   double grasp_height = 0.045;         ///< grasp centre above the table top at the grasp, m
   double pregrasp_height = 0.06;       ///< m above the grasp
   double carry_height = 0.05;          ///< m above the place pose
-  double place_clearance = 0.005;      ///< cube bottom above the table top when opening, m
+  double place_clearance = 0.005;      ///< object bottom above the table top when opening, m
   double path_peak_speed = 0.9;        ///< m/s, peak tip speed of a path's quintic timing
+  double lower_peak_speed = 0.3;       ///< m/s, the same for the last path, lowering the object onto the table
+                                       ///< (at 0.9 the arm swung and set objects down 13 mm off, median)
   double max_node_speed = 0.9;         ///< m/s, planned peak speed of any node (paths are slowed to it)
   int min_segment_steps = 60;          ///< shortest path, control steps
   double settle_speed = 0.05;          ///< m/s: close / open only when every node is slower
@@ -85,9 +99,9 @@ struct PickPlaceConfig {
 };
 
 struct PickPlaceTask {
-  Eigen::Vector3d cube{0, 0, 0};   ///< cube centre at the start
-  double cube_yaw = 0;             ///< rad
-  Eigen::Vector3d place{0, 0, 0};  ///< where the cube centre should end (on the table)
+  Eigen::Vector3d object{0, 0, 0}; ///< object centre at the start
+  double object_yaw = 0;           ///< rad (the can: of its axis)
+  Eigen::Vector3d place{0, 0, 0};  ///< where the object centre should end (on the table)
   double gripper_yaw = 0;          ///< rad, in [-pi/4, pi/4]
   int draws = 0;                   ///< candidates drawn
 };
@@ -105,8 +119,8 @@ struct PickPlaceResult {
   double max_node_speed = 0;       ///< m/s, any rod node at any substep
   double max_path_ratio = 0;       ///< measured end-effector path / straight distance, worst segment
   double max_planned_ratio = 0;    ///< the planner's tip path / straight distance, worst segment
-  double place_error = 0;          ///< m, horizontal, cube centre to the place point at the end
-  double tilt = 0;                 ///< rad, of the cube's most vertical face axis at the end
+  double place_error = 0;          ///< m, horizontal, object centre to the place point at the end
+  double tilt = 0;                 ///< rad at the end: the cube's most vertical face axis off the vertical, the can's axis off the horizontal
   int grasp_step = -1, release_step = -1;
 };
 
@@ -134,13 +148,19 @@ class PickPlaceRunner {
     table_ = world::tabletop_table();
     top_ = table_.top_center.z();
     world_.add_table(table_);
-    rigid::RigidBodyDesc cube;
-    cube.shape = geometry::Box<double>{Vec3::Constant(config_.cube_half)};
-    cube.position = parking_spot();
-    cube.mass = config_.cube_mass;
-    cube.friction = 0.6;
-    cube.name = "cube";
-    cube_ = world_.add_object(cube);
+    rigid::RigidBodyDesc body;
+    if (config_.object == PickPlaceObject::can) {
+      body.shape = geometry::Cylinder<double>{config_.can_radius, config_.can_half_length};
+      body.rolling_resistance = config_.can_rolling_resistance;
+      body.name = "can";
+    } else {
+      body.shape = geometry::Box<double>{Vec3::Constant(config_.cube_half)};
+      body.name = "cube";
+    }
+    body.position = parking_spot();
+    body.mass = config_.object_mass;
+    body.friction = 0.6;
+    object_ = world_.add_object(body);
     observation_ = control::make_arm_observation<double>(params_.n_elements, config_.observe_stride);
     torques_.setZero(params_.n_elements, 3);
     go_home();
@@ -150,7 +170,9 @@ class PickPlaceRunner {
   /// Control steps of the reset from the straight arm to the home pose (not part of episodes).
   int home_steps() const { return home_steps_; }
   const World& world() const { return world_; }
-  rigid::BodyId cube() const { return cube_; }
+  /// The executor as it is at the settled home state (every episode starts from a copy).
+  const Executor& home_executor() const { return home_executor_; }
+  rigid::BodyId object() const { return object_; }
 
   /// The tool-down end-effector pose whose grasp centre is at `grasp_center` with yaw `yaw`.
   Pose tool_down(const Vec3& grasp_center, double yaw) const {
@@ -169,21 +191,28 @@ class PickPlaceRunner {
     const double pi = std::numbers::pi;
     PickPlaceTask t;
     for (t.draws = 1; t.draws <= 1000; ++t.draws) {
-      t.cube = Vec3(uniform(0.30, 0.62), uniform(-0.25, 0.25), top_ + config_.cube_half);
-      t.cube_yaw = uniform(-pi, pi);
+      t.object = Vec3(uniform(0.30, 0.62), uniform(-0.25, 0.25), top_ + half_height());
+      t.object_yaw = uniform(-pi, pi);
       const double distance = uniform(0.15, 0.25), direction = uniform(-pi, pi);
-      t.place = t.cube + distance * Vec3(std::cos(direction), std::sin(direction), 0);
+      t.place = t.object + distance * Vec3(std::cos(direction), std::sin(direction), 0);
       if (t.place.x() < 0.30 || t.place.x() > 0.62 || std::abs(t.place.y()) > 0.25) continue;
-      t.gripper_yaw = t.cube_yaw - (pi / 2) * std::round(t.cube_yaw / (pi / 2));
+      // The cube: a quarter turn is a symmetry, so yaw in [-45, 45] deg. The can: the fingers
+      // close across its axis (yaw + 90 deg), and a half turn is a symmetry: [-90, 90] deg.
+      if (config_.object == PickPlaceObject::can) {
+        const double across = t.object_yaw + pi / 2;
+        t.gripper_yaw = across - pi * std::round(across / pi);
+      } else {
+        t.gripper_yaw = t.object_yaw - (pi / 2) * std::round(t.object_yaw / (pi / 2));
+      }
       // The whole sequence is planned from home (on a copy of the home executor): every path
-      // accepted (continuous, within the limits with the cube's weight once it is held) and
+      // accepted (continuous, within the limits with the object's weight once it is held) and
       // every waypoint shape clear of the table top.
       planner_ = home_executor_;
       const auto w = waypoints(t, Vec3::Zero());
-      const Vec3 nominal_in_hand = w[1].rotation.transpose() * (t.cube - w[1].translation);
+      const Vec3 nominal_in_hand = w[1].rotation.transpose() * (t.object - w[1].translation);
       bool ok = true;
       for (std::size_t i = 0; i < w.size() && ok; ++i) {
-        if (i == 2) planner_.set_payload(config_.cube_mass, nominal_in_hand);
+        if (i == 2) planner_.set_payload(config_.object_mass, nominal_in_hand);
         const auto report = planner_.track_line(w[i], 100);
         ok = report.accepted && report.max_torque_ratio <= config_.plan_torque_ratio;
         planner_.complete_path();
@@ -205,8 +234,8 @@ class PickPlaceRunner {
     const PickPlaceTask& t = res.task;
     world_.soft().restore(home_snapshot_);
     executor_ = home_executor_;
-    world_.rigid().set_pose(cube_, t.cube, Eigen::Quaterniond(Eigen::AngleAxisd(t.cube_yaw, Vec3::UnitZ())));
-    world_.rigid().set_velocity(cube_, Vec3::Zero(), Vec3::Zero());
+    world_.rigid().set_pose(object_, t.object, start_orientation(t.object_yaw));
+    world_.rigid().set_velocity(object_, Vec3::Zero(), Vec3::Zero());
     const auto wp = waypoints(t, Vec3::Zero());  // pre-grasp, grasp, carry, place (hand offset corrected at the grasp)
     Pose place = wp[3], carry = wp[2];
     int phase = 0, s = 0, waited = 0, rest = 0;
@@ -215,10 +244,10 @@ class PickPlaceRunner {
     double seg_path = 0, seg_straight = 0;
     Vec3 last_ee = ee_pose().translation;
     bool in_segment = false;
-    auto start_path = [&](const Pose& goal) {
+    auto start_path = [&](const Pose& goal, double peak_speed) {
       const double distance = (goal.translation - executor_.statics().desired_tip_pose().translation).norm();
       const int steps = std::max(config_.min_segment_steps,
-                                 static_cast<int>(std::ceil(1.875 * distance / config_.path_peak_speed / control_dt())));
+                                 static_cast<int>(std::ceil(1.875 * distance / peak_speed / control_dt())));
       const std::clock_t s0 = std::clock();
       const auto report = executor_.track_line(goal, steps, config_.max_node_speed * control_dt());
       const double setup = double(std::clock() - s0) / CLOCKS_PER_SEC;
@@ -239,7 +268,7 @@ class PickPlaceRunner {
       if (in_segment && seg_straight > 1e-3) res.max_path_ratio = std::max(res.max_path_ratio, seg_path / seg_straight);
       in_segment = false;
     };
-    if (!start_path(wp[0])) res.failure = "path_refused";
+    if (!start_path(wp[0], config_.path_peak_speed)) res.failure = "path_refused";
     while (res.failure.empty() && !res.success) {
       if (res.steps >= config_.max_steps) {
         res.failure = "timeout";
@@ -271,7 +300,7 @@ class PickPlaceRunner {
         case 0:  // approach -> descend
           if (done && error < config_.start_error) {
             end_segment();
-            if (!start_path(wp[1])) res.failure = "path_refused";
+            if (!start_path(wp[1], config_.path_peak_speed)) res.failure = "path_refused";
             phase = 1;
           }
           break;
@@ -287,38 +316,38 @@ class PickPlaceRunner {
           break;
         case 2: {  // closed this step: did it grasp?
           const auto held = world_.gripper().held();
-          if (!held || *held != cube_) {
+          if (!held || *held != object_) {
             res.failure = "missed_grasp";
             break;
           }
           res.grasp_step = res.steps;
-          // Where the cube sits in the hand (end-effector frame): the payload hint and the place correction.
-          const Vec3 in_hand = ee.rotation.transpose() * (world_.rigid().center_of_mass(cube_) - ee.translation);
-          executor_.set_payload(config_.cube_mass, in_hand);
+          // Where the object sits in the hand (end-effector frame): the payload hint and the place correction.
+          const Vec3 in_hand = ee.rotation.transpose() * (world_.rigid().center_of_mass(object_) - ee.translation);
+          executor_.set_payload(config_.object_mass, in_hand);
           place.translation = t.place - place.rotation * in_hand + Vec3(0, 0, config_.place_clearance);
           carry.translation = place.translation + Vec3(0, 0, config_.carry_height);
-          if (!start_path(carry)) res.failure = "path_refused";
+          if (!start_path(carry, config_.path_peak_speed)) res.failure = "path_refused";
           phase = 3;
           break;
         }
         case 3:  // carry -> lower
-          if (!held_cube()) {
+          if (!held_object()) {
             res.failure = "dropped";
             break;
           }
           if (done && error < config_.start_error) {
             end_segment();
-            if (!start_path(place)) res.failure = "path_refused";
+            if (!start_path(place, config_.lower_peak_speed)) res.failure = "path_refused";
             phase = 4;
           }
           break;
         case 4:  // lower -> open when settled
-          if (!held_cube()) {
+          if (!held_object()) {
             res.failure = "dropped";
             break;
           }
-          // The table already carries the cube (it touches the top): open now rather than press it in.
-          if (world_.rigid().center_of_mass(cube_).z() < top_ + config_.cube_half + 0.002) {
+          // The table already carries the object (it touches the top): open now rather than press it in.
+          if (world_.rigid().center_of_mass(object_).z() < top_ + half_height() + 0.002) {
             end_segment();
             s = 0;
             executor_.set_payload(0.0);
@@ -334,11 +363,11 @@ class PickPlaceRunner {
             }
           }
           break;
-        case 5:  // opened: wait for the cube to rest
+        case 5:  // opened: wait for the object to rest
         default: {
           res.release_step = res.release_step < 0 ? res.steps : res.release_step;
-          const Vec3 v = world_.rigid().linear_velocity(cube_), w = world_.rigid().angular_velocity(cube_);
-          rest = (v.norm() < 0.01 && w.norm() < 0.1 && !held_cube()) ? rest + 1 : 0;
+          const Vec3 v = world_.rigid().linear_velocity(object_), w = world_.rigid().angular_velocity(object_);
+          rest = (v.norm() < 0.01 && w.norm() < 0.1 && !held_object()) ? rest + 1 : 0;
           if (rest >= config_.rest_steps) {
             evaluate(res);
             if (!res.failure.empty()) break;
@@ -357,14 +386,14 @@ class PickPlaceRunner {
   }
 
   /// The waypoints of task t: pre-grasp, grasp, carry, place (tool-down end-effector poses);
-  /// `in_hand` the cube centre in the end-effector frame (zero: the grasp centre's nominal one).
+  /// `in_hand` the object centre in the end-effector frame (zero: the grasp centre's nominal one).
   std::array<Pose, 4> waypoints(const PickPlaceTask& t, const Vec3& in_hand) const {
-    const Vec3 grasp_center(t.cube.x(), t.cube.y(), top_ + config_.grasp_height);
+    const Vec3 grasp_center(t.object.x(), t.object.y(), top_ + config_.grasp_height);
     const Pose grasp = tool_down(grasp_center, t.gripper_yaw);
     Pose pre = grasp;
     pre.translation.z() += config_.pregrasp_height;
-    // Nominal hand offset: the cube centre grasp_height - cube_half below the grasp centre.
-    const Vec3 nominal = in_hand.isZero() ? Vec3(0, 0, gripper_.grasp_center().z() + config_.grasp_height - config_.cube_half) : in_hand;
+    // Nominal hand offset: the object centre grasp_height - half_height() below the grasp centre.
+    const Vec3 nominal = in_hand.isZero() ? Vec3(0, 0, gripper_.grasp_center().z() + config_.grasp_height - half_height()) : in_hand;
     Pose place = grasp;
     place.translation = t.place - place.rotation * nominal + Vec3(0, 0, config_.place_clearance);
     Pose carry = place;
@@ -374,13 +403,17 @@ class PickPlaceRunner {
 
  private:
   static PickPlaceConfig validated(const PickPlaceConfig& c) {
-    manisoft::detail::require_positive("PickPlaceConfig cube_mass", c.cube_mass);
+    manisoft::detail::require_positive("PickPlaceConfig object_mass", c.object_mass);
     manisoft::detail::require_positive("PickPlaceConfig cube_half", c.cube_half);
+    manisoft::detail::require_positive("PickPlaceConfig can_radius", c.can_radius);
+    manisoft::detail::require_positive("PickPlaceConfig can_half_length", c.can_half_length);
+    manisoft::detail::require_non_negative("PickPlaceConfig can_rolling_resistance", c.can_rolling_resistance);
     manisoft::detail::require_positive("PickPlaceConfig dt", c.dt);
     if (c.substeps < 1) manisoft::detail::fail("PickPlaceConfig substeps = ", c.substeps, " must be >= 1");
     if (c.max_steps < 1) manisoft::detail::fail("PickPlaceConfig max_steps = ", c.max_steps, " must be >= 1");
     manisoft::detail::require_non_negative("PickPlaceConfig rod_damping", c.rod_damping);
     manisoft::detail::require_positive("PickPlaceConfig path_peak_speed", c.path_peak_speed);
+    manisoft::detail::require_positive("PickPlaceConfig lower_peak_speed", c.lower_peak_speed);
     if (c.min_segment_steps < 1) manisoft::detail::fail("PickPlaceConfig min_segment_steps = ", c.min_segment_steps, " must be >= 1");
     if (c.home_path_steps < 1) manisoft::detail::fail("PickPlaceConfig home_path_steps = ", c.home_path_steps, " must be >= 1");
     if (!c.home.allFinite()) manisoft::detail::fail("PickPlaceConfig home is not finite");
@@ -395,16 +428,24 @@ class PickPlaceRunner {
   }
 
   double control_dt() const { return config_.dt * config_.substeps; }
-  Vec3 parking_spot() const { return Vec3(0.72, 0.42, 0.75 + config_.cube_half); }
+  Vec3 parking_spot() const { return Vec3(0.72, 0.42, 0.75 + half_height()); }
+  /// Height of the object's centre above its support when it lies as drawn.
+  double half_height() const { return config_.object == PickPlaceObject::can ? config_.can_radius : config_.cube_half; }
+  /// A cube stands on a face; a can lies on its side, its axis (the cylinder's z) along (cos yaw, sin yaw, 0).
+  Eigen::Quaterniond start_orientation(double yaw) const {
+    Eigen::Quaterniond q(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
+    if (config_.object == PickPlaceObject::can) q = q * Eigen::Quaterniond(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY()));
+    return q;
+  }
 
   Pose ee_pose() const {
     const auto f = world_.soft().end_effector_frame();
     return Pose{f.rotation, f.position};
   }
   double max_node_speed_now() const { return world_.rod().state().velocities.rowwise().norm().maxCoeff(); }
-  bool held_cube() const {
+  bool held_object() const {
     const auto h = world_.gripper().held();
-    return h && *h == cube_;
+    return h && *h == object_;
   }
 
   /// From the straight arm to the home pose: a tracked path, then held; saved as the episodes' start.
@@ -427,15 +468,18 @@ class PickPlaceRunner {
 
   /// Success geometry at the end: horizontal distance to the place point and tilt.
   void evaluate_geometry(PickPlaceResult& res) const {
-    const Vec3 c = world_.rigid().center_of_mass(cube_);
+    const Vec3 c = world_.rigid().center_of_mass(object_);
     res.place_error = (c - res.task.place).head<2>().norm();
-    const Eigen::Matrix3d r = world_.rigid().orientation(cube_).toRotationMatrix();
-    const double up = std::min(1.0, r.row(2).cwiseAbs().maxCoeff());
-    res.tilt = std::acos(up);
+    const Eigen::Matrix3d r = world_.rigid().orientation(object_).toRotationMatrix();
+    if (config_.object == PickPlaceObject::can) {
+      res.tilt = std::asin(std::min(1.0, std::abs(r(2, 2))));  // the axis out of the horizontal
+    } else {
+      res.tilt = std::acos(std::min(1.0, r.row(2).cwiseAbs().maxCoeff()));
+    }
   }
   void evaluate(PickPlaceResult& res) const {
     evaluate_geometry(res);
-    const Vec3 c = world_.rigid().center_of_mass(cube_);
+    const Vec3 c = world_.rigid().center_of_mass(object_);
     if (res.place_error > config_.success_distance || c.z() < top_) res.failure = "off_target";
     else if (res.tilt > config_.flat_angle) res.failure = "tilted";
   }
@@ -450,7 +494,7 @@ class PickPlaceRunner {
   Executor planner_{executor_};
   world::TableDesc table_;
   double top_ = 0.75;
-  rigid::BodyId cube_ = 0;
+  rigid::BodyId object_ = 0;
   control::Observation<double> observation_;
   Array3 torques_;
   World::Soft::Snapshot home_snapshot_;

@@ -40,6 +40,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/QR>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -161,6 +162,11 @@ class InverseStatics {
     for (int k = n - 1; k >= 0; --k) {
       acc += model_.gravity * model_.rod.node_masses[k + 1];
       distal_force_.row(k) = acc.transpose();
+      const Scalar softest = std::max({Scalar(1) / model_.rod.shear_stiffness(k, 0), Scalar(1) / model_.rod.shear_stiffness(k, 1),
+                                       Scalar(1) / model_.rod.shear_stiffness(k, 2)});
+      if (!(acc.norm() * softest < Scalar(0.5)))
+        manisoft::detail::fail("InverseStatics: element ", k, " would shear or stretch by ", acc.norm() * softest,
+                               " under the weight it carries (at most 0.5): the rod is too soft for its load");
     }
     build_regularizer();
     state_.positions.setZero(n + 1, 3);
@@ -170,6 +176,8 @@ class InverseStatics {
     state_.external_forces.setZero(n + 1, 3);
     state_.external_torques.setZero(n, 3);
     directors_.resize(n);
+    rotation_a_.assign(n - 1, Scalar(1));
+    rotation_b_.assign(n - 1, Scalar(0.5));
     positions_cache_.assign(n + 1, model_.base_position);
     feedforward_.setZero(n, 3);
     elastic_torques_.setZero(n, 3);
@@ -430,23 +438,29 @@ class InverseStatics {
   /// iterations used.
   int relieve(const Pose& target, Coefficients& c, Residual& r) {
     int used = 0;
+    Scalar ratio = 0;
+    Scalar e0 = effort(c, ratio);
     for (int step = 0; step < settings_.relief_iterations; ++step) {
-      Scalar ratio = 0;
-      const Scalar e0 = effort(c, ratio);
       if (!(ratio > settings_.relief_threshold)) break;
-      Coefficients g;
-      for (int j = 0; j < n_coefficients; ++j) {
-        Coefficients cj = c;
-        const Scalar h = Scalar(1e-6) * (Scalar(1) + std::abs(c[j]));
-        cj[j] += h;
-        Scalar unused = 0;
-        g[j] = (effort(cj, unused) - e0) / h;
-      }
+      // The W-projected descent -(I - W^-1 J^T (J W^-1 J^T)^-1 J) W^-1 grad E equals -N N^T grad E
+      // for a W-orthonormal basis N of the null space of J (N^T W N = I, J N = 0): with W = L L^T,
+      // N = L^-T Y, Y an orthonormal basis of the null space of J L^-T (the last columns of a QR
+      // of its transpose). So E is differentiated along the 3 columns of N only (forward
+      // differences), not along all 9 coefficients.
       jacobian(c, r, target);
-      const Eigen::Matrix<Scalar, n_coefficients, 6> wj = regularizer_inverse_ * jacobian_.transpose();
-      const Eigen::Matrix<Scalar, 6, 6> m = jacobian_ * wj;
-      const Coefficients wg = regularizer_inverse_ * g;
-      const Coefficients d = -(wg - wj * m.ldlt().solve(jacobian_ * wg));  // W-projected descent
+      const Eigen::Matrix<Scalar, n_coefficients, 6> a_t = (jacobian_ * regularizer_factor_inverse_t_).transpose();
+      const Eigen::ColPivHouseholderQR<Eigen::Matrix<Scalar, n_coefficients, 6>> qr(a_t);
+      const Matrix9 q = qr.householderQ();
+      constexpr int n_free = n_coefficients - 6;
+      const Eigen::Matrix<Scalar, n_coefficients, n_free> basis = regularizer_factor_inverse_t_ * q.template rightCols<n_free>();
+      const Scalar c_scale = Scalar(1) + c.template lpNorm<Eigen::Infinity>();
+      Eigen::Matrix<Scalar, n_free, 1> slope;
+      for (int j = 0; j < n_free; ++j) {
+        const Scalar h = Scalar(1e-6) * c_scale / basis.col(j).template lpNorm<Eigen::Infinity>();
+        Scalar unused = 0;
+        slope[j] = (effort(c + h * basis.col(j), unused) - e0) / h;
+      }
+      const Coefficients d = -(basis * slope);  // W-projected descent
       const Scalar d_norm = d.norm();
       if (!(d_norm > Scalar(0))) break;
       const Scalar strength = std::min(Scalar(1), (ratio - settings_.relief_threshold) / (Scalar(1) - settings_.relief_threshold));
@@ -456,10 +470,14 @@ class InverseStatics {
         Coefficients trial = c + std::ldexp(length / d_norm, -half) * d;
         Residual r_trial = residual(trial, target);
         used += newton(target, trial, r_trial, 4);
-        Scalar unused = 0;
-        if (r_trial.norm() < settings_.accept_error && effort(trial, unused) < e0) {
+        if (!(r_trial.norm() < settings_.accept_error)) continue;
+        Scalar trial_ratio = 0;
+        const Scalar e_trial = effort(trial, trial_ratio);
+        if (e_trial < e0) {
           c = trial;
           r = r_trial;
+          e0 = e_trial;
+          ratio = trial_ratio;
           kept = true;
         }
       }
@@ -596,7 +614,12 @@ class InverseStatics {
     for (int k = 0; k < n - 1; ++k) {
       const Scalar l0v = model_.rod.rest_voronoi_lengths[k];
       const Vector3 phi = -curvature(c, k) * l0v;
-      const Matrix3 g = l0v * directors_[k].transpose() * math::so3::right_jacobian(phi);
+      // J_r(phi) = I - B [phi]x + C [phi]x^2, C = (theta - sin theta) / theta^3 = (1 - A) / theta^2
+      // (A, B of this phi from shape(); the series below theta^2 = 1e-6).
+      const Scalar theta2 = phi.squaredNorm();
+      const Scalar cc = theta2 < Scalar(1e-6) ? Scalar(1) / Scalar(6) - theta2 / Scalar(120) : (Scalar(1) - rotation_a_[k]) / theta2;
+      const Matrix3 right_jacobian = (Scalar(1) - cc * theta2) * Matrix3::Identity() - rotation_b_[k] * math::so3::hat(phi) + cc * phi * phi.transpose();
+      const Matrix3 g = l0v * directors_[k].transpose() * right_jacobian;
       const Vector3 arm = tip_ - positions_cache_[k + 1];
       Eigen::Matrix<Scalar, 6, 3> block;
       block.template topRows<3>() = -math::so3::hat(arm) * g;
@@ -611,14 +634,24 @@ class InverseStatics {
   }
 
   /// Forward statics of coefficients c into directors_ and the shape's node positions (state_
-  /// positions are only written by commit()).
+  /// positions are only written by commit()). The shape depends on c alone, so the buffers are
+  /// reused when they already hold c's shape (the solvers evaluate the same c several times).
   void shape(const Coefficients& c) {
+    if (shape_known_ && c == shape_of_) return;
     const int n = n_elements();
     const auto& rod = model_.rod;
     directors_[0] = model_.base_directors;
     for (int k = 0; k < n - 1; ++k) {
+      // Exp(phi) = I + A [phi]x + B [phi]x^2 = (1 - B theta^2) I + A [phi]x + B phi phi^T with
+      // A = sin(theta) / theta, B = (1 - cos theta) / theta^2, from one sine and cosine of theta / 2.
       const Vector3 phi = -curvature(c, k) * rod.rest_voronoi_lengths[k];
-      directors_[k + 1] = math::so3::exp(phi) * directors_[k];
+      const Scalar theta2 = phi.squaredNorm(), half = Scalar(0.5) * std::sqrt(theta2);
+      const Scalar half_sinc = math::detail::sin_over_angle(half);
+      const Scalar a = half_sinc * std::cos(half), b = Scalar(0.5) * half_sinc * half_sinc;
+      rotation_a_[k] = a;
+      rotation_b_[k] = b;
+      const Matrix3 rotation = (Scalar(1) - b * theta2) * Matrix3::Identity() + a * math::so3::hat(phi) + b * phi * phi.transpose();
+      directors_[k + 1] = rotation * directors_[k];
     }
     Vector3 x = model_.base_position;
     for (int k = 0; k < n; ++k) {
@@ -626,20 +659,19 @@ class InverseStatics {
       const Vector3 force_material = q * distal_force_.row(k).transpose();
       const Vector3 compliance(Scalar(1) / rod.shear_stiffness(k, 0), Scalar(1) / rod.shear_stiffness(k, 1),
                                Scalar(1) / rod.shear_stiffness(k, 2));
-      // u = sigma0 + e3 + |u| S^-1 Q f  (fixed point; S^-1 Q f ~ 1e-3, converges to round-off in ~6 sweeps)
+      // u = b + |u| l with b = sigma0 + e3, l = S^-1 Q f (|l| ~ 1e-3): s = |u| is the positive
+      // root of (1 - |l|^2) s^2 - 2 (b . l) s - |b|^2 = 0 (|l| < 1/2 checked at construction).
       const Vector3 base = rod.rest_sigma.row(k).transpose() + Vector3::UnitZ();
       const Vector3 load = compliance.cwiseProduct(force_material);
-      Vector3 u = base + load;
-      for (int i = 0; i < 8; ++i) {
-        const Vector3 next = base + u.norm() * load;
-        const Scalar change = (next - u).squaredNorm();
-        u = next;
-        if (change < Scalar(1e-30)) break;
-      }
+      const Scalar bl = base.dot(load), a = Scalar(1) - load.squaredNorm();
+      const Scalar stretch = (bl + std::sqrt(bl * bl + a * base.squaredNorm())) / a;
+      const Vector3 u = base + stretch * load;
       x += rod.rest_lengths[k] * (q.transpose() * u);
       positions_cache_[k + 1] = x;
     }
     tip_ = x;
+    shape_of_ = c;
+    shape_known_ = true;
   }
 
   /// Copies the current shape buffers into the desired state and recomputes the feed-forward.
@@ -704,6 +736,10 @@ class InverseStatics {
       regularizer_.template block<3, 3>(3 * axis, 3 * axis) = block + settings_.curvature_weight * mass;
     }
     regularizer_inverse_ = regularizer_.ldlt().solve(Matrix9::Identity());
+    // W = L L^T; relieve() uses L^-T.
+    const Eigen::LLT<Matrix9> llt(regularizer_);
+    if (llt.info() != Eigen::Success) manisoft::detail::fail("InverseStatics: the effort norm W is not positive definite");
+    regularizer_factor_inverse_t_ = llt.matrixU().solve(Matrix9::Identity());
   }
 
   ArmModel<Scalar> model_;
@@ -716,6 +752,9 @@ class InverseStatics {
   std::vector<Matrix3> directors_;
   std::vector<Vector3> positions_cache_;
   Vector3 tip_ = Vector3::Zero();
+  std::vector<Scalar> rotation_a_, rotation_b_;   ///< A, B of each Voronoi point's rotation (shape())
+  Coefficients shape_of_ = Coefficients::Zero();  ///< the coefficients whose shape the buffers hold
+  bool shape_known_ = false;
   Array3 feedforward_;
   Array3 elastic_torques_, payload_torques_;
   Scalar stiffness_scale_ = Scalar(1);
@@ -730,6 +769,7 @@ class InverseStatics {
   Jacobian jacobian_;
   Matrix9 regularizer_;
   Matrix9 regularizer_inverse_;
+  Matrix9 regularizer_factor_inverse_t_;  ///< L^-T, W = L L^T
 };
 
 }  // namespace manisoft::rod
