@@ -102,7 +102,7 @@ struct PickPlaceTask {
   Eigen::Vector3d object{0, 0, 0}; ///< object centre at the start
   double object_yaw = 0;           ///< rad (the can: of its axis)
   Eigen::Vector3d place{0, 0, 0};  ///< where the object centre should end (on the table)
-  double gripper_yaw = 0;          ///< rad, in [-pi/4, pi/4]
+  double gripper_yaw = 0;          ///< rad, in [-pi/4, pi/4] (cube) or [-pi/2, pi/2] (can)
   int draws = 0;                   ///< candidates drawn
 };
 
