@@ -87,7 +87,7 @@ void BM_TrackLineSetup(benchmark::State& state) {
   for (std::uint64_t s = 0; s < 50; ++s) {
     const auto task = runner.draw_task(100000 + s);
     paths.push_back(runner.waypoints(task, Eigen::Vector3d::Zero()));
-    in_hand.push_back(paths.back()[1].rotation.transpose() * (task.object - paths.back()[1].translation));
+    in_hand.push_back(runner.nominal_in_hand(task));
   }
   manisoft::control::ModelExecutor<double> executor = runner.home_executor();
   std::size_t i = 0;

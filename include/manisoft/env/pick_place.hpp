@@ -209,10 +209,9 @@ class PickPlaceRunner {
       // every waypoint shape clear of the table top.
       planner_ = home_executor_;
       const auto w = waypoints(t, Vec3::Zero());
-      const Vec3 nominal_in_hand = w[1].rotation.transpose() * (t.object - w[1].translation);
       bool ok = true;
       for (std::size_t i = 0; i < w.size() && ok; ++i) {
-        if (i == 2) planner_.set_payload(config_.object_mass, nominal_in_hand);
+        if (i == 2) planner_.set_payload(config_.object_mass, nominal_in_hand(t));
         const auto report = planner_.track_line(w[i], 100);
         ok = report.accepted && report.max_torque_ratio <= config_.plan_torque_ratio;
         planner_.complete_path();
@@ -383,6 +382,13 @@ class PickPlaceRunner {
   }
   PickPlaceResult run(std::uint64_t seed) {
     return run(seed, [](int, int) {});
+  }
+
+  /// The object centre in the end-effector frame at the nominal grasp of task t (the payload
+  /// offset a planner assumes before the grasp is measured).
+  Vec3 nominal_in_hand(const PickPlaceTask& t) const {
+    const Pose grasp = waypoints(t, Vec3::Zero())[1];
+    return grasp.rotation.transpose() * (t.object - grasp.translation);
   }
 
   /// The waypoints of task t: pre-grasp, grasp, carry, place (tool-down end-effector poses);

@@ -91,7 +91,7 @@ struct ExpertConfig {
   double release_lift = 0.0;        ///< m: the stop above where the arm is (release_settle_speed)
   double contact_depth = 0.004;     ///< m: a tall object is lowered until its support carries it: its lower line ends this far below its support
   double retract_peak_speed = 0.9;  ///< m/s: peak end-effector speed of the retract after a release
-  double lower_peak_speed = 0.5;    ///< m/s: peak end-effector speed of the lower line
+  double lower_peak_speed = 0.3;    ///< m/s: peak end-effector speed of the lower line
   double approach_tip_clearance = 0.02;  ///< m: a tall object's approach keeps the open fingertips this far above its top until they straddle it
   double carry_settle_speed = 0.1;  ///< m/s: lower only once the arm's tip is slower at the end of the carry (0: at once)
   double start_error = 0.03;       ///< m: a chained path starts once the previous one is this near
