@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # generate_dataset end to end (issue 15): a small dataset (ALN and ARR, 3 clean + 3 randomized
-# episodes) made as 1 shard and as 3 shards run by GNU parallel with --index-only as the merge
+# episodes; a second one, COLL and STK, 2 + 2, is generated, verified and read too, so every task
+# and setting is covered) made as 1 shard and as 3 shards run by GNU parallel with --index-only as the merge
 # step must be identical file for file, bit for bit; a run killed mid-way and resumed must give the
 # same files; verify_dataset accepts it, and names a truncated episode file; the h5py reader
 # (examples/python/read_dataset.py) reads it; dataset_stats.py draws its plots and export_zarr.py
@@ -84,6 +85,14 @@ fi
 summary=$("$python" "$reader" "$work/one")  # not piped into grep -q: an early exit would break the reader's pipe
 grep -q "demos 6 " <<< "$summary" || { echo "FAIL: read_dataset.py: $summary"; exit 1; }
 
+# the other two tasks, clean and randomized: one episode of each pair, verified and read back
+"$gen" --tasks COLL,STK --clean 2 --randomized 2 --seed 7 --out "$work/coll_stk" --jobs 2 > /dev/null
+"$verify" "$work/coll_stk"
+summary=$("$python" "$reader" "$work/coll_stk")
+for pair in COLL/clean COLL/randomized STK/clean STK/randomized; do
+  grep -q "^  $pair: 1$" <<< "$summary" || { echo "FAIL: no $pair episode in the COLL + STK dataset: $summary"; exit 1; }
+done
+
 # the paper's figure 4 plots and table, and Diffusion Policy's zarr layout
 "$python" "$examples/dataset_stats.py" "$work/one" --out "$work/stats" > /dev/null
 for f in lengths categories heatmap instructions; do [[ -s $work/stats/$f.png ]] || { echo "FAIL: no $f.png"; exit 1; }; done
@@ -101,4 +110,4 @@ assert np.array_equal(z["data/action"][:], actions), "actions"
 assert z["data/rod_centerline"].shape == (ends[-1], 63), z["data/rod_centerline"].shape
 assert z["data/rod_directors"].shape == (ends[-1], 180), z["data/rod_directors"].shape
 PY
-echo "generate_dataset: 1 shard == 3 shards == killed + resumed; verify, h5py read, stats and zarr export OK"
+echo "generate_dataset: 1 shard == 3 shards == killed + resumed; verify, h5py read (all four tasks), stats and zarr export OK"
