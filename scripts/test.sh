@@ -9,7 +9,8 @@
 #      examples they run; the other examples and the per-header check compile at -O0 without
 #      sanitizers, for warnings only (no benchmarks).
 # Tests that instantiate the same templates share an executable built as one unity translation
-# unit (tests/CMakeLists.txt): the world or the executor is compiled once per group, not per file.
+# unit (tests/CMakeLists.txt): every test of the world, the executor, the assets, the scenes, the
+# tasks and the recorded expert is one unit, so the world is compiled once, not once per group.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 jobs=${JOBS:-2}

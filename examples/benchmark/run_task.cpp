@@ -60,6 +60,7 @@ int main(int argc, char** argv) {
   app.add_option("--retract-speed", expert_config.retract_peak_speed, "expert: peak end-effector speed of the retract after a release, m/s")->check(CLI::PositiveNumber);
   app.add_option("--release-settle-speed", expert_config.release_settle_speed, "expert: a tall object is let go once the arm's tip is slower, m/s")->check(CLI::NonNegativeNumber);
   app.add_option("--lower-speed", expert_config.lower_peak_speed, "expert: peak end-effector speed of the lower line, m/s")->check(CLI::PositiveNumber);
+  app.add_option("--tight-clearance", expert_config.tight_clearance, "expert: a grasp whose open fingers clear the object by less a side is descended to at --lower-speed, m (0: never)")->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
   expert_config.check_arm_clearance = !no_arm_check;
   try {

@@ -453,7 +453,7 @@ TEST_CASE("an L-shaped prism becomes >= 2 convex pieces whose volumes add up to 
   CHECK((r.asset.center_of_mass - Vec3(0.25 / 3 - 0.1, 0.25 / 3 - 0.1, 0.025)).norm() < 1e-9);
 }
 
-TEST_CASE("a mug: concave, decomposed; the cavity stays free and the volume is kept", "[import]") {
+TEST_CASE("a mug: concave, decomposed, the cavity stays free and the volume is kept", "[import]") {
   double volume = 0;
   const TriMesh m = mug(&volume);
   const std::string file = write("mug.obj", to_obj(m));

@@ -29,7 +29,7 @@ double cubic(double s, int direction) { return (direction + 1) * (3 - 20 * s + 3
 
 }  // namespace
 
-TEST_CASE("element torque actions pass through; the limits clamp them once", "[executor][action]") {
+TEST_CASE("element torque actions pass through, the limits clamp them once", "[executor][action]") {
   control::ElementTorqueAction<double> space(4, length, {150, 75});
   CHECK(space.rows() == 4);
   Array3 action(4, 3), torques = Array3::Zero(4, 3);

@@ -125,7 +125,7 @@ TEST_CASE("failure to open an EGL display or device is a clear error", "[render]
   CHECK_THROWS_WITH(GlRenderer(options), Contains("device_index = -7"));
 }
 
-TEST_CASE("object centres project onto their objects; depth matches", "[render]") {
+TEST_CASE("object centres project onto their objects, and depth matches", "[render]") {
   GlRenderer& gl = renderer();
   gl.set_scene(known_scene());
   const FrameState frame = known_frame();

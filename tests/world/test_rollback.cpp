@@ -96,7 +96,7 @@ void require_identical(const World& a, const World& b) {
 
 }  // namespace
 
-TEST_CASE("a step that fails part-way is undone; continuing is bit-identical to never trying it", "[world][rollback]") {
+TEST_CASE("a step that fails part-way is undone, and continuing is bit-identical to never trying it", "[world][rollback]") {
   World a = make_world(), b = make_world();
   const int n = a.rod().n_elements();
   for (int c = 0; c < 150; ++c) {

@@ -28,10 +28,11 @@
 // the annotation's approach direction, approach_distance from the grasp; "via": first level to
 // above it, for a tall object high enough that the fingertips pass approach_tip_clearance above
 // its top; candidates whose approach would sweep the open fingers into a tall object come last:
-// approach_clear()), grasp, close once settled
+// approach_clear()), grasp (at lower_peak_speed when the grasp is tight: tight_clearance), close once settled
 // (the arm's tip slower than settle_speed), carry (above the place pose, diagonal from the grasp;
 // "via": first straight up by lift_height), place (corrected for where the object sits in the
-// hand, measured when it is held; lowered at lower_peak_speed once the arm's tip is slower than
+// hand, measured when it is held, with the target orientation's symmetric equivalent nearest the
+// held one; lowered at lower_peak_speed once the arm's tip is slower than
 // carry_settle_speed), open once settled or as soon as the support carries the object (a tall
 // one, height above tall_ratio x width, is lowered on until its support carries it, contact_depth
 // below, so it is not dropped onto its rim; the arm stops there, release_lift up, and opens once
@@ -94,6 +95,7 @@ struct ExpertConfig {
   double lower_peak_speed = 0.3;    ///< m/s: peak end-effector speed of the lower line
   double approach_tip_clearance = 0.02;  ///< m: a tall object's approach keeps the open fingertips this far above its top until they straddle it
   double carry_settle_speed = 0.1;  ///< m/s: lower only once the arm's tip is slower at the end of the carry (0: at once)
+  double tight_clearance = 0.015;   ///< m: a grasp is tight when the open fingers clear the object by less on each side: descend to it at lower_peak_speed
   double start_error = 0.03;       ///< m: a chained path starts once the previous one is this near
   double via_error = 0.05;          ///< m: the same at a leg's arc or via point (the next line starts from the shape target; the arm catches up)
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
@@ -198,6 +200,7 @@ class Expert {
     int object = -1;
     Pose object_target;  ///< asset frame -> world at release
     Pose grasp, place;   ///< end-effector poses
+    double width = 0;    ///< m, the object's width between the fingers (the grasp annotation's)
     double sink = 0;     ///< m the object is lowered into a container below its rim (COLL)
     bool via_approach = false, via_carry = false;
     Pose start;  ///< the end-effector pose the approach leg starts from
@@ -389,10 +392,8 @@ class Expert {
 
   /// The goal orientation's symmetric equivalent that turns least from `now` (about world z).
   static Eigen::Matrix3d nearest_equivalent(const Eigen::Matrix3d& now, const Eigen::Matrix3d& goal, const scene::Symmetry& sym) {
-    if (sym.kind == scene::Symmetry::Kind::axial) {
-      // only the axis matters: keep the current yaw, take the goal's axis (both upright here)
-      return now;
-    }
+    if (sym.kind == scene::Symmetry::Kind::axial)  // only the axis matters: `now` turned least to the goal's axis
+      return Eigen::Quaterniond::FromTwoVectors(now.col(2), goal.col(2)).toRotationMatrix() * now;
     const int n = sym.kind == scene::Symmetry::Kind::discrete ? std::max(1, sym.order) : 1;
     Eigen::Matrix3d best = goal;
     double best_angle = 10;
@@ -402,6 +403,12 @@ class Expert {
       if (a < best_angle) best_angle = a, best = g;
     }
     return best;
+  }
+
+  /// Whether the yaw of the object's target pose is free: the object is round, or the task
+  /// (all but ALN) states no orientation.
+  bool yaw_free(int object) const {
+    return env_->spec().task != scene::Task::aln || scene::asset_symmetry(asset_of(object)).kind == scene::Symmetry::Kind::axial;
   }
 
   /// Angle between an end-effector orientation and the home one.
@@ -433,6 +440,7 @@ class Expert {
             Plan p;
             p.object = object;
             p.object_target = target;
+            p.width = g.width;
             p.grasp = now * about_axis * g.grasp * half;
             p.place = target * now.inverse() * p.grasp;
             sink_into_container(p);
@@ -652,6 +660,13 @@ class Expert {
     return up;
   }
 
+  /// Whether the open fingers clear the object by less than tight_clearance on each side (a
+  /// plate, a bowl, a shoe): the arm then descends at lower_peak_speed, since its sideways sway
+  /// on a fast descent lands a finger on the object's rim and tips it.
+  bool tight_grasp() const {
+    return 0.5 * (env_->gripper_parameters().open_width - plan_.width) < config_.tight_clearance;
+  }
+
   /// How near the end of line leg_ of `leg` the arm must be for the next path to start:
   /// via_error at an arc or via point, start_error at the leg's last pose.
   double chain_error(const Leg& leg) const { return leg_ + 1 < leg.count ? config_.via_error : config_.start_error; }
@@ -669,11 +684,11 @@ class Expert {
     switch (phase_) {
       case ExpertPhase::approach:
         if (done && error < chain_error(plan_.approach_leg)) {
-          if (++leg_ < plan_.approach_leg.count) {
-            start_leg(plan_.approach_leg, leg_);
+          if (leg_ + 1 < plan_.approach_leg.count) {
+            start_leg(plan_.approach_leg, ++leg_);
           } else {
             enter(ExpertPhase::descend);
-            start_path(plan_.grasp);
+            start_path(plan_.grasp, true, tight_grasp() ? config_.lower_peak_speed : 0.0);
           }
         }
         break;
@@ -699,6 +714,12 @@ class Expert {
         const Pose object = state_of(plan_.object).pose;
         const auto& a = asset_of(plan_.object);
         executor_.set_payload(a.mass, ee.rotation.transpose() * (object.act(a.center_of_mass) - ee.translation));
+        {
+          // the object's target orientation nearest the one this grasp would release it in
+          const Eigen::Matrix3d would_be = (plan_.place * ee.inverse() * object).rotation;
+          const auto symmetry = yaw_free(plan_.object) ? scene::Symmetry{scene::Symmetry::Kind::axial, 0} : scene::asset_symmetry(a);
+          plan_.object_target.rotation = nearest_equivalent(would_be, plan_.object_target.rotation, symmetry);
+        }
         plan_.place = plan_.object_target * object.inverse() * ee;
         set_carry_leg(plan_);
         {
