@@ -21,6 +21,9 @@ using manisoft::test::slurp;
 const std::string scratch = manisoft::test::scratch_dir("manisoft_reach_eval_test").string();
 
 int run(const std::string& arguments) {
+  // test_world does not depend on the reach_eval target (the build then starts it early)
+  INFO("the reach_eval program is missing: build the reach_eval target (" MANISOFT_REACH_EVAL ")");
+  REQUIRE(std::filesystem::exists(MANISOFT_REACH_EVAL));
   std::filesystem::create_directories(scratch);
   return manisoft::test::run_command(MANISOFT_REACH_EVAL, arguments, scratch + "/log.txt");
 }
