@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/task/expert.hpp"
@@ -39,15 +40,19 @@ SceneSpec sample(Task t, std::uint64_t index) {
   return sampler().sample(q);
 }
 
-/// Runs `expert` on `e` from scene `s` for at most `max_steps` control steps (or until done).
-void run_expert(TaskEnv& e, Expert& expert, const SceneSpec& s, int max_steps = 100000) {
+/// Runs `expert` on `e` from scene `s` for at most `max_steps` control steps (or until done);
+/// `after_step`, when given, sees each step's outcome with the phase the expert acted in.
+void run_expert(TaskEnv& e, Expert& expert, const SceneSpec& s, int max_steps = 100000,
+                const std::function<void(manisoft::task::ExpertPhase)>& after_step = {}) {
   e.reset(s);
   expert.reset();
   TaskEnv::Array3 torques;
   int gripper = 0;
   for (int i = 0; i < max_steps && !e.done(); ++i) {
     expert.act(torques, gripper);
+    const auto phase = expert.phase();
     e.step(torques, gripper);
+    if (after_step) after_step(phase);
   }
 }
 
@@ -238,24 +243,17 @@ TEST_CASE("the expert descends to a tight grasp slowly and stacks two plates", "
     REQUIRE(asset.grasps.size() > 0);
     for (const auto& g : asset.grasps) CHECK(0.5 * (e.gripper_parameters().open_width - g.width) < config.tight_clearance);
   }
-  e.reset(s);
-  expert.reset();
-  TaskEnv::Array3 torques;
-  int gripper = 0;
   double descend_peak = 0;  // m/s, the end-effector's downward speed over the descend phase, one control step apart
   int descend_steps = 0;
-  Eigen::Vector3d last = e.world().soft().end_effector_frame().position;
-  while (!e.done()) {
-    expert.act(torques, gripper);
-    const bool descending = expert.phase() == manisoft::task::ExpertPhase::descend;
-    e.step(torques, gripper);
+  Eigen::Vector3d last = Eigen::Vector3d::Zero();  // set at every step; the first step is an approach
+  run_expert(e, expert, s, 100000, [&](manisoft::task::ExpertPhase phase) {
     const Eigen::Vector3d now = e.world().soft().end_effector_frame().position;
-    if (descending) {
+    if (phase == manisoft::task::ExpertPhase::descend) {
       descend_peak = std::max(descend_peak, (last.z() - now.z()) / e.control_dt());
       ++descend_steps;
     }
     last = now;
-  }
+  });
   CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure), descend_steps);
   CHECK(e.info().success);
   REQUIRE(descend_steps > 0);
