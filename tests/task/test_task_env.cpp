@@ -263,4 +263,29 @@ TEST_CASE("the expert descends to a tight grasp slowly and stacks two plates", "
   CHECK(descend_peak < 1.5 * config.lower_peak_speed);
 }
 
+TEST_CASE("the carry lifts the held object and the gripper over the container's rim", "[tasks][expert]") {
+  // COLL clean 19: the pill bottle stands 14 cm beside the basket's side (rim 8.5 cm up). A carry
+  // straight from the grasp to above the basket rises through the rim: the gripper pushed the
+  // basket 25 cm aside before the expert checked the held object and the gripper along the carry.
+  const SceneSpec s = sample(Task::coll, 19);
+  TaskEnv& e = env();
+  auto container_travel = [&](const manisoft::task::ExpertConfig& config) {
+    Expert expert(e, config);
+    e.reset(s);
+    const Eigen::Vector3d start = e.snapshot().objects[static_cast<std::size_t>(s.goal.container)].pose.translation;
+    double travel = 0;
+    run_expert(e, expert, s, 100000, [&](manisoft::task::ExpertPhase) {
+      travel = std::max(travel, (e.snapshot().objects[static_cast<std::size_t>(s.goal.container)].pose.translation - start).norm());
+    });
+    return travel;
+  };
+  manisoft::task::ExpertConfig unchecked;
+  unchecked.check_arm_clearance = false;
+  CHECK(container_travel(unchecked) > 0.05);
+  const double travel = container_travel({});
+  CAPTURE(manisoft::task::to_string(e.info().failure));
+  CHECK(e.info().success);
+  CHECK(travel < 0.005);
+}
+
 }  // namespace test_task_env

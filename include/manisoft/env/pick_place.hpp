@@ -68,7 +68,7 @@ struct PickPlaceConfig {
   double cube_half = 0.025;            ///< m
   double can_radius = 0.033;           ///< m (a 330 ml drinks can)
   double can_half_length = 0.058;      ///< m
-  double can_rolling_resistance = 5e-4;  ///< m, as every asset (a bare cube keeps 0)
+  double can_rolling_resistance = 5e-4;  ///< m (the assets use 2 mm; a bare cube keeps 0)
   double dt = 2e-4;                    ///< s
   int substeps = 7;                    ///< per control step (714 Hz)
   int max_steps = 1500;                ///< control steps per episode (the paper's horizon)

@@ -21,8 +21,10 @@
 // within the actuation limits, the payload included), whose waypoint shapes keep every rod
 // node table_clearance above the table top, and along whose lines (line_samples shapes each)
 // the rod keeps arm_clearance from the bounding box of every obstacle and every object but the
-// moved one (arm_clear; the gripper and the held object are not checked). No detour around an
-// obstacle is planned: a move with no clear candidate is given up.
+// moved one (arm_clear); along the carry lines the held object's and the open gripper's boxes
+// keep held_clearance from the other objects' and obstacles' boxes, except those they cannot
+// avoid at the grasp or the place (held_clear). No detour around an obstacle is planned: a move
+// with no clear candidate is given up.
 // Waypoints of a move (the end-effector frame; straight lines with quintic timing, or a cruise
 // at constant speed over path_cruise of the line: ModelExecutor::track_line): approach (along
 // the annotation's approach direction, approach_distance from the grasp; "via": first level to
@@ -30,10 +32,13 @@
 // its top; candidates whose approach would sweep the open fingers into a tall object come last:
 // approach_clear()), grasp (at lower_peak_speed when the grasp is tight: tight_clearance), close once settled
 // (the arm's tip slower than settle_speed), carry (above the place pose, diagonal from the grasp;
-// "via": first straight up by lift_height), place (corrected for where the object sits in the
-// hand, measured when it is held, with the target orientation's symmetric equivalent nearest the
-// held one; lowered at lower_peak_speed once the arm's tip is slower than
-// carry_settle_speed), open once settled or as soon as the support carries the object (a tall
+// "via": first straight up by lift_height, or until the object's bottom is 2 x held_clearance
+// above every other object and obstacle near its course: corridor_top), place (corrected for
+// where the object sits in the hand, measured when it is held, with the target orientation's
+// symmetric equivalent nearest the held one; the corrected carry is checked again and, when
+// refused, the other kind of carry tried), lowered once the arm's tip is slower than
+// carry_settle_speed: at lower_peak_speed, a long lower (into a container) at the carry's speed
+// until slow_lower above its end first, open once settled or as soon as the support carries the object (a tall
 // one, height above tall_ratio x width, is lowered on until its support carries it, contact_depth
 // below, so it is not dropped onto its rim; the arm stops there, release_lift up, and opens once
 // its tip is slower than release_settle_speed), then up at retract_peak_speed until the
@@ -57,6 +62,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -93,6 +99,7 @@ struct ExpertConfig {
   double contact_depth = 0.004;     ///< m: a tall object is lowered until its support carries it: its lower line ends this far below its support
   double retract_peak_speed = 0.9;  ///< m/s: peak end-effector speed of the retract after a release
   double lower_peak_speed = 0.3;    ///< m/s: peak end-effector speed of the lower line
+  double slow_lower = 0.03;         ///< m: a lower line longer than twice this runs at the carry's speed until this far above its end (0: all slow)
   double approach_tip_clearance = 0.02;  ///< m: a tall object's approach keeps the open fingertips this far above its top until they straddle it
   double carry_settle_speed = 0.1;  ///< m/s: lower only once the arm's tip is slower at the end of the carry (0: at once)
   double tight_clearance = 0.015;   ///< m: a grasp is tight when the open fingers clear the object by less on each side: descend to it at lower_peak_speed
@@ -100,6 +107,7 @@ struct ExpertConfig {
   double via_error = 0.05;          ///< m: the same at a leg's arc or via point (the next line starts from the shape target; the arm catches up)
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
   double arm_clearance = 0.01;      ///< m: the rod's surface clear of the other objects' and obstacles' boxes along planned lines
+  double held_clearance = 0.01;     ///< m: the held object's and the open gripper's boxes clear of theirs along the carry
   bool check_arm_clearance = true;  ///< false: lines are not checked against objects and obstacles (for measuring the check)
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
   int max_retries = 1;              ///< re-tries of a missed grasp
@@ -145,6 +153,10 @@ class Expert {
         arm_margin_(std::sqrt(env.arm_model().rod.cross_section_area.maxCoeff() / std::numbers::pi) + config.arm_clearance) {
     const int n = env.arm_model().rod.n_elements;
     observation_ = control::make_arm_observation<double>(n, env.config().observe_stride);
+    const auto& gp = env.gripper_parameters();
+    gripper_half_ = Vec3(std::max(gp.palm_half_x, 0.5 * gp.open_width + gp.finger_thickness), std::max(gp.palm_half_y, gp.finger_half_width),
+                         0.5 * (gp.palm_thickness + gp.finger_length));
+    gripper_center_ = Vec3(0, 0, gripper_half_.z());
     events_.reserve(64);
   }
 
@@ -157,6 +169,7 @@ class Expert {
     s_ = 0;
     waited_ = 0;
     touched_ = false;
+    lower_fast_ = false;
     steps_ = 0;
     events_.clear();
     failure_ = nullptr;
@@ -317,12 +330,45 @@ class Expert {
     Pose prev = p.grasp;
     if (p.via_carry) {
       Pose lift = p.grasp;
-      lift.translation.z() += config_.lift_height;
+      lift.translation.z() += std::max(config_.lift_height, corridor_top(p) + 2 * config_.held_clearance - state_of(p.object).pose.translation.z());
       above.translation.z() = std::max(above.translation.z(), lift.translation.z());
       append_leg(p.carry_leg, prev, lift);
       prev = lift;
     }
     append_leg(p.carry_leg, prev, above);
+  }
+
+  /// The highest top (world z) of the other objects and obstacles near the carry's course from
+  /// the grasp to the place (the straight line or, at the edge of the reach, its arc point:
+  /// append_leg), horizontally within their footprint radius plus the moved object's plus
+  /// held_clearance; the table top when there are none.
+  double corridor_top(const Plan& p) const {
+    Leg course;
+    append_leg(course, p.grasp, p.place);
+    const double r = scene::footprint_radius(asset_of(p.object)) + config_.held_clearance;
+    auto near = [&](const Pose& pose, const assets::Asset& asset) {
+      const Eigen::Vector2d c = pose.act(asset.bounding_center).head<2>();
+      Eigen::Vector2d a = p.grasp.translation.head<2>();
+      for (int i = 0; i < course.count; ++i) {
+        const Eigen::Vector2d b = course.pose[static_cast<std::size_t>(i)].translation.head<2>(), ab = b - a;
+        const double t = ab.squaredNorm() > 1e-12 ? std::clamp((c - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+        if ((a + t * ab - c).norm() < scene::footprint_radius(asset) + r) return true;
+        a = b;
+      }
+      return false;
+    };
+    auto top = [](const Pose& pose, const assets::Asset& asset) { return pose.act(asset.bounding_center).z() + asset.bounding_half_extents.z(); };
+    const auto& s = env_->spec();
+    double z = s.table.top_center.z();
+    for (std::size_t i = 0; i < s.objects.size(); ++i) {
+      const int o = static_cast<int>(i);
+      if (o != p.object && near(state_of(o).pose, asset_of(o))) z = std::max(z, top(state_of(o).pose, asset_of(o)));
+    }
+    for (const auto& o : s.obstacles) {
+      const auto& asset = env_->library().get(o.asset_id, "expert obstacle");
+      if (near(o.pose, asset)) z = std::max(z, top(o.pose, asset));
+    }
+    return z;
   }
 
   int count_moves() const {
@@ -388,6 +434,15 @@ class Expert {
       }
     }
     manisoft::detail::fail("Expert: no move ", k);
+  }
+
+  /// What move k puts its object into or onto (COLL: the container, STK: the item below; -1: the
+  /// table): the carry keeps clear of it until it lowers the object.
+  int support_of(int k) const {
+    const auto& s = env_->spec();
+    if (s.task == scene::Task::coll) return s.goal.container;
+    if (s.task == scene::Task::stk) return s.goal.items.at(static_cast<std::size_t>(k));
+    return -1;
   }
 
   /// The goal orientation's symmetric equivalent that turns least from `now` (about world z).
@@ -473,7 +528,14 @@ class Expert {
       if (ok && !(ok = check_line(c.plan.grasp, why))) where = "grasp";
       if (ok) {
         planner_.set_payload(a.mass, c.plan.grasp.rotation.transpose() * (now.act(a.center_of_mass) - c.plan.grasp.translation));
-        if (!(ok = check_leg(c.plan.carry_leg, why))) where = "carry";
+        held_in_ee_ = c.plan.grasp.inverse() * now;
+        held_near_ = 0;
+        note_held_near(c.plan.grasp);
+        note_held_near(c.plan.place, support_of(k));
+        check_held_ = true;
+        ok = check_leg(c.plan.carry_leg, why);
+        check_held_ = false;
+        if (!ok) where = "carry";
       }
       if (ok && !(ok = check_line(c.plan.place, why))) where = "place";
       if (ok) {
@@ -491,11 +553,12 @@ class Expert {
   /// within table_clearance of the table top.
   bool check_line(const Pose& to, const char*& why) {
     planner_backup_ = planner_;
+    const Pose from = planner_.statics().desired_tip_pose();
     const auto report = planner_.track_line(to, 100, std::numeric_limits<double>::infinity(), config_.path_cruise);
     bool clear = true;
     for (int k = 1; k <= line_samples && report.accepted && clear; ++k) {
       planner_.predicted_shape(100 * k / line_samples, shape_);
-      clear = arm_clear(shape_);
+      clear = arm_clear(shape_) && held_clear(from, to, double(k) / line_samples);
     }
     planner_.complete_path();
     if (!report.accepted || !clear) {
@@ -532,9 +595,75 @@ class Expert {
     return true;
   }
 
+  /// Whether the held object (check_held_: along a carry leg), carried at held_in_ee_ by the
+  /// end-effector at fraction u of the straight line from -> to, and the open gripper's box keep
+  /// held_clearance clear of the bounding box of every obstacle and every other object but those
+  /// they are that near where the carry starts or the object is placed (held_near_: unavoidable;
+  /// its support excepted). Oriented boxes, separating axes.
+  bool held_clear(const Pose& from, const Pose& to, double u) const {
+    if (!check_held_ || !config_.check_arm_clearance) return true;
+    Pose ee;
+    ee.translation = from.translation + u * (to.translation - from.translation);
+    ee.rotation = Eigen::Quaterniond(from.rotation).slerp(u, Eigen::Quaterniond(to.rotation)).toRotationMatrix();
+    const Pose held = ee * held_in_ee_;
+    const auto& ha = asset_of(plan_object_);
+    auto hit = [&](const Pose& pose, const assets::Asset& a) {
+      return boxes_overlap(held, ha, pose, a, config_.held_clearance) ||
+             boxes_overlap(ee, gripper_center_, gripper_half_, pose, a.bounding_center, a.bounding_half_extents, config_.held_clearance);
+    };
+    const auto& s = env_->spec();
+    for (std::size_t i = 0; i < s.objects.size(); ++i) {
+      const int o = static_cast<int>(i);
+      if (o != plan_object_ && !(held_near_ >> i & 1u) && hit(state_of(o).pose, asset_of(o))) return false;
+    }
+    for (const auto& o : s.obstacles)
+      if (hit(o.pose, env_->library().get(o.asset_id, "expert obstacle"))) return false;
+    return true;
+  }
+  /// Marks the objects the held object's or the gripper's box is within held_clearance of with
+  /// the end-effector at `ee` (where the carry starts, where the object is placed: unavoidable).
+  void note_held_near(const Pose& ee, int except = -1) {
+    const Pose held = ee * held_in_ee_;
+    const auto& s = env_->spec();
+    for (std::size_t i = 0; i < s.objects.size() && i < 64; ++i) {
+      const int o = static_cast<int>(i);
+      const auto& a = asset_of(o);
+      if (o != plan_object_ && o != except && (boxes_overlap(held, asset_of(plan_object_), state_of(o).pose, a, config_.held_clearance) ||
+                                boxes_overlap(ee, gripper_center_, gripper_half_, state_of(o).pose, a.bounding_center, a.bounding_half_extents, config_.held_clearance)))
+        held_near_ |= std::uint64_t(1) << i;
+    }
+  }
+  /// Whether the bounding boxes of assets a (at pose pa) and b (at pb) come within `margin` of
+  /// each other: no separating axis among the 15 of two oriented boxes.
+  static bool boxes_overlap(const Pose& pa, const assets::Asset& a, const Pose& pb, const assets::Asset& b, double margin) {
+    return boxes_overlap(pa, a.bounding_center, a.bounding_half_extents, pb, b.bounding_center, b.bounding_half_extents, margin);
+  }
+  /// The same for boxes of half extents ha (centre ca in frame pa) and hb (cb in pb).
+  static bool boxes_overlap(const Pose& pa, const Vec3& ca, const Vec3& ha, const Pose& pb, const Vec3& cb, const Vec3& hb, double margin) {
+    const Eigen::Matrix3d& ra = pa.rotation;
+    const Eigen::Matrix3d& rb = pb.rotation;
+    const Vec3 ea = ha + Vec3::Constant(0.5 * margin), eb = hb + Vec3::Constant(0.5 * margin);
+    const Vec3 d = pb.act(cb) - pa.act(ca);
+    auto separated = [&](const Vec3& axis) {
+      if (axis.squaredNorm() < 1e-12) return false;
+      const double ra_ = (ra.transpose() * axis).cwiseAbs().dot(ea), rb_ = (rb.transpose() * axis).cwiseAbs().dot(eb);
+      return std::abs(axis.dot(d)) > ra_ + rb_;
+    };
+    for (int i = 0; i < 3; ++i)
+      if (separated(ra.col(i)) || separated(rb.col(i))) return false;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (separated(ra.col(i).cross(rb.col(j)))) return false;
+    return true;
+  }
+
   /// Checks a ramp to `to` on planner_ (the cold inverse statics solution within the limits and
   /// clear of the table) and jumps to its end; false (the planner as before) otherwise.
   bool check_ramp(const Pose& to) {
+    // a held object is checked along the straight line (a ramp's own course is not known before it runs)
+    const Pose from = planner_.statics().desired_tip_pose();
+    for (int k = 1; k <= line_samples; ++k)
+      if (!held_clear(from, to, double(k) / line_samples)) return false;
     planner_backup_ = planner_;
     const auto r = planner_.set_target(to);
     planner_.complete_path();
@@ -722,14 +851,27 @@ class Expert {
         }
         plan_.place = plan_.object_target * object.inverse() * ee;
         set_carry_leg(plan_);
-        {
-          // the corrected carry, checked (and repaired) from here
+        // the corrected carry, checked (and repaired) from here; when it is refused, the other
+        // kind (direct or via the lift); when both are, the planned one as corrected
+        held_in_ee_ = ee.inverse() * object;
+        held_near_ = 0;
+        note_held_near(ee);
+        note_held_near(plan_.place, support_of(move_));
+        for (const bool via : {plan_.via_carry, !plan_.via_carry}) {
           Plan checked = plan_;
+          checked.via_carry = via;
+          set_carry_leg(checked);
           repair_ = true;
           planner_ = executor_;
           planner_.complete_path();
           const char* why = "";
-          if (check_leg(checked.carry_leg, why) && check_line(checked.place, why)) plan_ = checked;
+          check_held_ = true;
+          const bool ok = check_leg(checked.carry_leg, why);
+          check_held_ = false;
+          if (ok && check_line(checked.place, why)) {
+            plan_ = checked;
+            break;
+          }
         }
         leg_ = 0;
         enter(ExpertPhase::carry);
@@ -747,7 +889,11 @@ class Expert {
           } else if (!(config_.carry_settle_speed > 0) || speed < config_.carry_settle_speed || ++waited_ > config_.max_settle_steps) {
             waited_ = 0;
             enter(ExpertPhase::lower);
-            start_path(lower_goal(), true, config_.lower_peak_speed);
+            // a long lower (into a container) runs at the carry's speed to slow_lower above its end first
+            Pose fast = lower_goal();
+            fast.translation.z() += config_.slow_lower;
+            lower_fast_ = config_.slow_lower > 0 && target_.translation.z() - fast.translation.z() > config_.slow_lower;
+            start_path(lower_fast_ ? fast : lower_goal(), true, lower_fast_ ? 0.0 : config_.lower_peak_speed);
           }
         }
         break;
@@ -756,6 +902,14 @@ class Expert {
           give_up("dropped the object");
           break;
         }
+        if (lower_fast_ && !supported(state_of(plan_.object))) {
+          if (done && error < config_.start_error) {
+            lower_fast_ = false;
+            start_path(lower_goal(), true, config_.lower_peak_speed);
+          }
+          break;
+        }
+        lower_fast_ = false;
         // Its support already carries the object (it touches the table or another object, or
         // sank half the clearance below the release height): open now rather than press it in
         // until it slips.
@@ -817,6 +971,11 @@ class Expert {
   std::string plan_refusal_;  ///< why the least-turning grasp candidate was refused
   bool repair_ = true;        ///< check_leg may repair refused lines
   bool touched_ = false;      ///< the lower phase found the object supported
+  bool lower_fast_ = false;   ///< the lower phase's first, fast line (slow_lower)
+  bool check_held_ = false;   ///< check_line also checks the held object (held_clear)
+  Pose held_in_ee_;           ///< the held object's pose in the end-effector frame (held_clear)
+  Vec3 gripper_center_, gripper_half_;    ///< the open gripper's box (palm and fingers) in the end-effector frame
+  std::uint64_t held_near_ = 0;  ///< objects the held one or the gripper starts or ends near (held_clear)
 };
 
 }  // namespace manisoft::task
