@@ -312,8 +312,7 @@ class Expert {
     const auto& rc = asset_of(s.goal.container).receptacles.at(0);
     // A container whose opening the open gripper fits into (finger_clearance to spare, at any
     // yaw): the object goes down to its floor.
-    const auto& gp = env_->gripper_parameters();
-    const double reach = std::hypot(std::max(gp.palm_half_x, 0.5 * gp.open_width + gp.finger_thickness), std::max(gp.palm_half_y, gp.finger_half_width));
+    const double reach = std::hypot(gripper_half_.x(), gripper_half_.y());
     const double room = rc.inner_radius > 0 ? rc.inner_radius : rc.inner_half_extents.minCoeff();
     const double rim = (state_of(s.goal.container).pose * rc.opening).translation.z();
     p.sink = room >= reach + config_.finger_clearance ? rc.inner_depth
@@ -528,14 +527,7 @@ class Expert {
       if (ok && !(ok = check_line(c.plan.grasp, why))) where = "grasp";
       if (ok) {
         planner_.set_payload(a.mass, c.plan.grasp.rotation.transpose() * (now.act(a.center_of_mass) - c.plan.grasp.translation));
-        held_in_ee_ = c.plan.grasp.inverse() * now;
-        held_near_ = 0;
-        note_held_near(c.plan.grasp);
-        note_held_near(c.plan.place, support_of(k));
-        check_held_ = true;
-        ok = check_leg(c.plan.carry_leg, why);
-        check_held_ = false;
-        if (!ok) where = "carry";
+        if (!(ok = check_carry_leg(c.plan, c.plan.grasp, now, support_of(k), why))) where = "carry";
       }
       if (ok && !(ok = check_line(c.plan.place, why))) where = "place";
       if (ok) {
@@ -555,10 +547,10 @@ class Expert {
     planner_backup_ = planner_;
     const Pose from = planner_.statics().desired_tip_pose();
     const auto report = planner_.track_line(to, 100, std::numeric_limits<double>::infinity(), config_.path_cruise);
-    bool clear = true;
+    bool clear = report.accepted && held_line_clear(from, to);
     for (int k = 1; k <= line_samples && report.accepted && clear; ++k) {
       planner_.predicted_shape(100 * k / line_samples, shape_);
-      clear = arm_clear(shape_) && held_clear(from, to, double(k) / line_samples);
+      clear = arm_clear(shape_);
     }
     planner_.complete_path();
     if (!report.accepted || !clear) {
@@ -605,32 +597,47 @@ class Expert {
     Pose ee;
     ee.translation = from.translation + u * (to.translation - from.translation);
     ee.rotation = Eigen::Quaterniond(from.rotation).slerp(u, Eigen::Quaterniond(to.rotation)).toRotationMatrix();
-    const Pose held = ee * held_in_ee_;
-    const auto& ha = asset_of(plan_object_);
-    auto hit = [&](const Pose& pose, const assets::Asset& a) {
-      return boxes_overlap(held, ha, pose, a, config_.held_clearance) ||
-             boxes_overlap(ee, gripper_center_, gripper_half_, pose, a.bounding_center, a.bounding_half_extents, config_.held_clearance);
-    };
     const auto& s = env_->spec();
     for (std::size_t i = 0; i < s.objects.size(); ++i) {
       const int o = static_cast<int>(i);
-      if (o != plan_object_ && !(held_near_ >> i & 1u) && hit(state_of(o).pose, asset_of(o))) return false;
+      if (o != plan_object_ && !(held_near_ >> i & 1u) && held_near(ee, state_of(o).pose, asset_of(o))) return false;
     }
     for (const auto& o : s.obstacles)
-      if (hit(o.pose, env_->library().get(o.asset_id, "expert obstacle"))) return false;
+      if (held_near(ee, o.pose, env_->library().get(o.asset_id, "expert obstacle"))) return false;
     return true;
+  }
+  /// held_clear() at line_samples points of the straight line from -> to.
+  bool held_line_clear(const Pose& from, const Pose& to) const {
+    for (int k = 1; k <= line_samples; ++k)
+      if (!held_clear(from, to, double(k) / line_samples)) return false;
+    return true;
+  }
+  /// Whether the held object's box (held_in_ee_) or the open gripper's box, the end-effector at
+  /// `ee`, comes within held_clearance of the bounding box of `asset` at `pose`.
+  bool held_near(const Pose& ee, const Pose& pose, const assets::Asset& asset) const {
+    return boxes_overlap(ee * held_in_ee_, asset_of(plan_object_), pose, asset, config_.held_clearance) ||
+           boxes_overlap(ee, gripper_center_, gripper_half_, pose, asset.bounding_center, asset.bounding_half_extents, config_.held_clearance);
+  }
+  /// Checks plan p's carry leg on planner_ (check_leg) with the held object too (held_clear):
+  /// the object at `object` when the end-effector is at `ee`, where the carry starts; what it is
+  /// near there and at the place pose (but `support`) is not held against it.
+  bool check_carry_leg(Plan& p, const Pose& ee, const Pose& object, int support, const char*& why) {
+    held_in_ee_ = ee.inverse() * object;
+    held_near_ = 0;
+    note_held_near(ee);
+    note_held_near(p.place, support);
+    check_held_ = true;
+    const bool ok = check_leg(p.carry_leg, why);
+    check_held_ = false;
+    return ok;
   }
   /// Marks the objects the held object's or the gripper's box is within held_clearance of with
   /// the end-effector at `ee` (where the carry starts, where the object is placed: unavoidable).
   void note_held_near(const Pose& ee, int except = -1) {
-    const Pose held = ee * held_in_ee_;
     const auto& s = env_->spec();
     for (std::size_t i = 0; i < s.objects.size() && i < 64; ++i) {
       const int o = static_cast<int>(i);
-      const auto& a = asset_of(o);
-      if (o != plan_object_ && o != except && (boxes_overlap(held, asset_of(plan_object_), state_of(o).pose, a, config_.held_clearance) ||
-                                boxes_overlap(ee, gripper_center_, gripper_half_, state_of(o).pose, a.bounding_center, a.bounding_half_extents, config_.held_clearance)))
-        held_near_ |= std::uint64_t(1) << i;
+      if (o != plan_object_ && o != except && held_near(ee, state_of(o).pose, asset_of(o))) held_near_ |= std::uint64_t(1) << i;
     }
   }
   /// Whether the bounding boxes of assets a (at pose pa) and b (at pb) come within `margin` of
@@ -661,9 +668,7 @@ class Expert {
   /// clear of the table) and jumps to its end; false (the planner as before) otherwise.
   bool check_ramp(const Pose& to) {
     // a held object is checked along the straight line (a ramp's own course is not known before it runs)
-    const Pose from = planner_.statics().desired_tip_pose();
-    for (int k = 1; k <= line_samples; ++k)
-      if (!held_clear(from, to, double(k) / line_samples)) return false;
+    if (!held_line_clear(planner_.statics().desired_tip_pose(), to)) return false;
     planner_backup_ = planner_;
     const auto r = planner_.set_target(to);
     planner_.complete_path();
@@ -853,10 +858,6 @@ class Expert {
         set_carry_leg(plan_);
         // the corrected carry, checked (and repaired) from here; when it is refused, the other
         // kind (direct or via the lift); when both are, the planned one as corrected
-        held_in_ee_ = ee.inverse() * object;
-        held_near_ = 0;
-        note_held_near(ee);
-        note_held_near(plan_.place, support_of(move_));
         for (const bool via : {plan_.via_carry, !plan_.via_carry}) {
           Plan checked = plan_;
           checked.via_carry = via;
@@ -865,10 +866,7 @@ class Expert {
           planner_ = executor_;
           planner_.complete_path();
           const char* why = "";
-          check_held_ = true;
-          const bool ok = check_leg(checked.carry_leg, why);
-          check_held_ = false;
-          if (ok && check_line(checked.place, why)) {
+          if (check_carry_leg(checked, ee, object, support_of(move_), why) && check_line(checked.place, why)) {
             plan_ = checked;
             break;
           }
