@@ -3,6 +3,7 @@
 // targets through the B-spline action space, and bad flags or files are refused.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -31,7 +32,7 @@ int run(const std::string& arguments) {
 std::string log_text() { return slurp(scratch + "/log.txt"); }
 
 // CSV columns of reach_eval (see examples/reach_eval.cpp).
-constexpr int success_column = 7, position_error_column = 9, rotation_error_column = 10;
+constexpr int success_column = 7, position_error_column = 9, rotation_error_column = 10, node_speed_column = 19, path_ratio_column = 20;
 
 }  // namespace
 
@@ -94,6 +95,31 @@ TEST_CASE("reach_eval drives the B-spline muscle action space", "[executor][reac
     CHECK(row[rotation_error_column] < 0.1);
   }
   CHECK(header.rfind("index,target_x", 0) == 0);
+}
+
+TEST_CASE("reach_eval with a node speed bound keeps the transients of equilibria targets within issue 10's limits", "[executor][reach_eval]") {
+  // Issue 10's transient check: no node faster than 1.5 m/s, a tip path at most 1.5 x the
+  // straight distance. The default ramp (250 steps at least) sweeps equilibria target 0 of seed
+  // 1 (0.65 m away) at up to 3 m/s; bounded to a planned 1.25 m/s it takes longer and stays under 1.5.
+  const std::string out = scratch + "/bounded.csv";
+  std::string header;
+  REQUIRE(run("--targets 3 --seed 1 --set equilibria --out " + out) == 0);
+  double fastest_default = 0;
+  for (const auto& row : read_csv(out, header)) fastest_default = std::max(fastest_default, row[node_speed_column]);
+  CHECK(fastest_default > 1.5);
+  REQUIRE(run("--targets 3 --seed 1 --set equilibria --max-node-speed 1.25 --out " + out) == 0);
+  CHECK_THAT(log_text(), Catch::Matchers::Contains("success: 100.0% (3 of 3)"));
+  const auto rows = read_csv(out, header);
+  REQUIRE(rows.size() == 3);
+  for (const auto& row : rows) {
+    CAPTURE(row[0], row[node_speed_column], row[path_ratio_column]);
+    CHECK(row[success_column] == 1);
+    CHECK(row[node_speed_column] <= 1.5);
+    CHECK(row[node_speed_column] >= 0.9);  // the bound slows the ramp, it does not stop the arm
+    CHECK(row[path_ratio_column] <= 1.5);
+  }
+  CHECK(run("--seed 1 --max-node-speed 0 --out " + out) == 2);
+  CHECK_THAT(log_text(), Catch::Matchers::Contains("--max-node-speed must be > 0"));
 }
 
 TEST_CASE("reach_eval refuses bad flags and malformed weight files", "[executor][reach_eval][input]") {

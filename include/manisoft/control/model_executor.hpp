@@ -35,6 +35,14 @@
 //             inverse statics solutions (smoothstep) over max(ramp_steps, tip path / ramp_max_speed)
 //             control steps (at most max_ramp_steps): a blend whose tip sweeps a long path (it
 //             can be several times the arm's length) is slowed so the arm can follow it.
+//             Options (off by default; ModelExecutorSettings::smooth_ramp turns them on):
+//             ramp_max_node_step lengthens the ramp until no node's planned speed (the largest
+//             node displacement between samples of the timed blend) exceeds it; ramp_path_ratio
+//             puts via shapes into a blend whose tip path is longer than that ratio x the
+//             straight distance (the blend's midpoint shape with its tip pulled onto the straight
+//             line and re-solved near it, recursively; the ramp then runs piecewise linearly
+//             through them, each segment's share of the time proportional to its largest node
+//             path); ramp_cruise replaces smoothstep by track_line's cruise timing.
 //   stiffness estimate (after the ramp, while every observed node is slower than
 //             estimate_speed_gate and no actuator saturates): a stiffness error s/s_hat bends the arm, to first order, to
 //             the curvature (s_hat/s) c* of the desired one. Every `outer_period` steps the
@@ -79,6 +87,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -100,6 +109,10 @@ struct ModelExecutorSettings {
   int ramp_steps = 250;                    ///< control steps of the shape ramp to a new target (minimum)
   int max_ramp_steps = 800;                ///< longest ramp
   Scalar ramp_max_speed = Scalar(0.006);   ///< m per control step: mean tip speed along the ramp's path
+  Scalar ramp_max_node_step = std::numeric_limits<Scalar>::infinity();  ///< m per control step: planned peak speed of every node along the ramp (infinity: no bound)
+  Scalar ramp_path_ratio = std::numeric_limits<Scalar>::infinity();  ///< a ramp segment whose tip path exceeds this x its straight distance gets a via shape (infinity: one blend)
+  int ramp_via_depth = 4;                  ///< halvings of a ramp segment by via shapes, at most (up to 2^depth segments)
+  Scalar ramp_cruise = Scalar(0);          ///< ramp timing: 0 smoothstep; in (0, 1) the cruise timing of track_line (lower peak speed for the same duration)
   Scalar outer_speed_gate = Scalar(0.15);  ///< m/s: integrate only while every observed node is slower
   Scalar outer_max_shift = Scalar(0.3);    ///< bound on |p_s - p*| (m) and |log(R_s R*^T)| (rad)
   Scalar stiffness_gain = Scalar(1);       ///< g of the stiffness-scale estimate (0: off)
@@ -124,6 +137,20 @@ struct ModelExecutorSettings {
   Scalar converged_position = Scalar(0.005);  ///< m
   Scalar converged_rotation = Scalar(0.05);   ///< rad
   Scalar converged_speed = Scalar(0.05);      ///< m/s, every observed node
+
+  /// The defaults with a smooth shape ramp (issue 10's transient limits: no node faster than
+  /// 1.5 m/s, no tip path longer than 1.5 x the straight distance): the planned peak node speed
+  /// bounded by `max_node_step` (m per control step), via shapes where a blend's tip path exceeds
+  /// 1.3 x its straight distance, the cruise timing (peak 1.33 x the mean speed), and ramps up to
+  /// `max_ramp` control steps long. Slower than the default ramp (BENCHMARKS.md, "Executor").
+  static ModelExecutorSettings smooth_ramp(Scalar max_node_step, int max_ramp) {
+    ModelExecutorSettings s;
+    s.ramp_max_node_step = max_node_step;
+    s.ramp_path_ratio = Scalar(1.3);
+    s.ramp_cruise = Scalar(0.5);
+    s.max_ramp_steps = std::max(max_ramp, s.ramp_steps);
+    return s;
+  }
 };
 
 /// What track_line() planned (or why it refused).
@@ -161,6 +188,11 @@ class ModelExecutor {
     if (settings_.max_ramp_steps < settings_.ramp_steps)
       manisoft::detail::fail("ModelExecutor max_ramp_steps = ", settings_.max_ramp_steps, " must be >= ramp_steps = ", settings_.ramp_steps);
     manisoft::detail::require_positive("ModelExecutor ramp_max_speed", settings_.ramp_max_speed);
+    if (!(settings_.ramp_max_node_step > 0)) manisoft::detail::fail("ModelExecutor ramp_max_node_step = ", settings_.ramp_max_node_step, " must be > 0");
+    if (!(settings_.ramp_cruise >= Scalar(0) && settings_.ramp_cruise < Scalar(1))) manisoft::detail::fail("ModelExecutor ramp_cruise = ", settings_.ramp_cruise, " must be in [0, 1)");
+    if (!(settings_.ramp_path_ratio >= Scalar(1))) manisoft::detail::fail("ModelExecutor ramp_path_ratio = ", settings_.ramp_path_ratio, " must be >= 1");
+    if (settings_.ramp_via_depth < 0 || settings_.ramp_via_depth > 4)
+      manisoft::detail::fail("ModelExecutor ramp_via_depth = ", settings_.ramp_via_depth, " must be in [0, 4]");
     if (settings_.outer_period < 1) manisoft::detail::fail("ModelExecutor outer_period = ", settings_.outer_period, " must be >= 1");
     if (settings_.outer_delay < 0) manisoft::detail::fail("ModelExecutor outer_delay = ", settings_.outer_delay, " must be >= 0");
     manisoft::detail::require_positive("ModelExecutor outer_max_shift", settings_.outer_max_shift);
@@ -192,6 +224,7 @@ class ModelExecutor {
     desired_velocity_.setZero(n + 1, 3);
     previous_desired_.setZero(n + 1, 3);
     knot_positions_.setZero(n + 1, 3);
+    for (Array3& nodes : ramp_nodes_) nodes.setZero(n + 1, 3);
     knots_.reserve(static_cast<std::size_t>(settings_.max_knots) << settings_.max_subdivisions);
     knots_.push_back(Knot{Scalar(0), statics_.coefficients()});
   }
@@ -396,19 +429,47 @@ class ModelExecutor {
     ramp_start_ = statics_.coefficients();
     last_result_ = statics_.solve_cold(target);
     ramp_end_ = statics_.coefficients();
+    ramp_knots_[0] = ramp_start_;
+    ramp_knot_count_ = 1;
+    if (std::isfinite(settings_.ramp_path_ratio) && last_result_.within_limits && settings_.ramp_steps > 0) {
+      add_ramp_segment(ramp_start_, ramp_end_, 0);
+      statics_.set_coefficients(ramp_end_);
+    } else {
+      ramp_knots_[ramp_knot_count_++] = ramp_end_;
+    }
+    // the knots' blend parameters, proportional to the segments' node paths (so no segment is
+    // crossed faster than the others)
+    ramp_knot_s_[0] = 0;
+    for (std::size_t i = 1; i < static_cast<std::size_t>(ramp_knot_count_); ++i)
+      ramp_knot_s_[i] = ramp_knot_s_[i - 1] + (ramp_knot_count_ == 2 ? Scalar(1) : blend_node_path(ramp_knots_[i - 1], ramp_knots_[i]));
+    const auto last = static_cast<std::size_t>(ramp_knot_count_ - 1);
+    const Scalar total = ramp_knot_s_[last];
+    for (std::size_t i = 1; i <= last; ++i) ramp_knot_s_[i] = total > Scalar(0) ? ramp_knot_s_[i] / total : Scalar(i) / Scalar(last);
     // Ramp length: at least ramp_steps, longer when the blend's tip path (sampled) is long, so
-    // that the mean tip speed along it stays below ramp_max_speed.
+    // that the mean tip speed along it stays below ramp_max_speed, and when a node's planned
+    // peak speed (largest node displacement between samples of the timed blend) would exceed
+    // ramp_max_node_step.
     ramp_path_ = 0;
+    Scalar node_rate = 0;  // largest node displacement per unit of ramp time
+    const bool bound_nodes = std::isfinite(settings_.ramp_max_node_step);
     if (settings_.ramp_steps > 0) {
       Vector3 previous = statics_.tip_pose(ramp_start_).translation;
-      for (int i = 1; i <= ramp_samples; ++i) {
-        const Scalar x = Scalar(i) / Scalar(ramp_samples);
-        const Vector3 p = statics_.tip_pose(ramp_start_ + x * x * (Scalar(3) - Scalar(2) * x) * (ramp_end_ - ramp_start_)).translation;
+      if (bound_nodes) statics_.shape_positions(ramp_start_, ramp_nodes_[0]);
+      const int samples = ramp_samples * std::max(1, (ramp_knot_count_ - 1) / 2);
+      for (int i = 1; i <= samples; ++i) {
+        const Scalar x = Scalar(i) / Scalar(samples);
+        const Coefficients c = ramp_coefficients(ramp_timing(x));
+        const Vector3 p = statics_.tip_pose(c).translation;
         ramp_path_ += (p - previous).norm();
         previous = p;
+        if (bound_nodes) {
+          Array3& now = ramp_nodes_[i % 2];
+          statics_.shape_positions(c, now);
+          node_rate = std::max(node_rate, Scalar(samples) * (now - ramp_nodes_[(i + 1) % 2]).rowwise().norm().maxCoeff());
+        }
       }
     }
-    const Scalar needed = ramp_path_ / settings_.ramp_max_speed;
+    const Scalar needed = std::max(ramp_path_ / settings_.ramp_max_speed, bound_nodes ? node_rate / settings_.ramp_max_node_step : Scalar(0));
     ramp_steps_ = settings_.ramp_steps == 0 ? 0 : std::clamp(static_cast<int>(std::ceil(needed)), settings_.ramp_steps, settings_.max_ramp_steps);
     statics_.set_coefficients(ramp_steps_ > 0 ? ramp_start_ : ramp_end_);
     tracking_ = false;
@@ -449,8 +510,7 @@ class ModelExecutor {
     }
     if (steps_ < ramp_steps_) {
       const Scalar x = Scalar(steps_ + 1) / Scalar(ramp_steps_);
-      const Scalar blend = x * x * (Scalar(3) - Scalar(2) * x);
-      statics_.set_coefficients(ramp_start_ + blend * (ramp_end_ - ramp_start_));
+      statics_.set_coefficients(ramp_coefficients(ramp_timing(x)));
     } else {
       outer_loop(o);
     }
@@ -624,8 +684,7 @@ class ModelExecutor {
   }
 
   /// Sampled tip path of the linear coefficient blend a -> b (m); uses the solver's buffers.
-  Scalar blend_tip_path(const Coefficients& a, const Coefficients& b) {
-    constexpr int samples = 4;
+  Scalar blend_tip_path(const Coefficients& a, const Coefficients& b, int samples = 4) {
     Vector3 previous = statics_.tip_pose(a).translation;
     Scalar path = 0;
     for (int i = 1; i <= samples; ++i) {
@@ -705,6 +764,63 @@ class ModelExecutor {
     return true;
   }
 
+  /// Appends the ramp's knots from shape a (the last knot) to shape b. A blend whose tip path is
+  /// longer than ramp_path_ratio x the straight distance of its ends gets a via shape: the
+  /// blend's midpoint shape, its tip moved to the straight line's midpoint (or 0.6, 0.3 of the
+  /// way there) and re-solved near it (solve_near, else solve_from), kept when within the
+  /// limits and the two blends through it are shorter; each half is checked again, at most
+  /// ramp_via_depth halvings deep.
+  void add_ramp_segment(const Coefficients& a, const Coefficients& b, int depth) {
+    if (depth < settings_.ramp_via_depth) {
+      const Vector3 pa = statics_.tip_pose(a).translation, pb = statics_.tip_pose(b).translation;
+      const Scalar path = blend_tip_path(a, b, 8);
+      if (path > settings_.ramp_path_ratio * (pb - pa).norm() + Scalar(1e-3)) {
+        const Coefficients mid = Scalar(0.5) * (a + b);
+        const Pose blend_mid = statics_.tip_pose(mid);
+        for (const Scalar pull : {Scalar(1), Scalar(0.6), Scalar(0.3)}) {
+          const Pose via{blend_mid.rotation, blend_mid.translation + pull * (Scalar(0.5) * (pa + pb) - blend_mid.translation)};
+          auto r = statics_.solve_near(via, mid, 20);
+          if (!r.within_limits) r = statics_.solve_from(via, mid);
+          if (!r.within_limits) continue;
+          const Coefficients v = statics_.coefficients();
+          if (blend_tip_path(a, v, 8) + blend_tip_path(v, b, 8) < Scalar(0.98) * path) {
+            add_ramp_segment(a, v, depth + 1);
+            add_ramp_segment(v, b, depth + 1);
+            return;
+          }
+        }
+      }
+    }
+    ramp_knots_[static_cast<std::size_t>(ramp_knot_count_++)] = b;
+  }
+
+  /// The largest node displacement along the blend from shape a to b, summed over 4 samples.
+  Scalar blend_node_path(const Coefficients& a, const Coefficients& b) {
+    constexpr int samples = 4;
+    statics_.shape_positions(a, ramp_nodes_[0]);
+    Scalar path = 0;
+    for (int i = 1; i <= samples; ++i) {
+      statics_.shape_positions(Coefficients(a + (Scalar(i) / Scalar(samples)) * (b - a)), ramp_nodes_[static_cast<std::size_t>(i % 2)]);
+      path += (ramp_nodes_[1] - ramp_nodes_[0]).rowwise().norm().maxCoeff();
+    }
+    return path;
+  }
+
+  /// The ramp's blend parameter at time fraction x: smoothstep, or path_timing with ramp_cruise.
+  Scalar ramp_timing(Scalar x) const {
+    return settings_.ramp_cruise > Scalar(0) ? path_timing(x, settings_.ramp_cruise) : x * x * (Scalar(3) - Scalar(2) * x);
+  }
+
+  /// The ramp's shape at blend parameter s in [0, 1]: linear between its knots.
+  Coefficients ramp_coefficients(Scalar s) const {
+    if (ramp_knot_count_ <= 2) return ramp_start_ + s * (ramp_end_ - ramp_start_);
+    std::size_t hi = 1;
+    while (hi + 1 < static_cast<std::size_t>(ramp_knot_count_) && ramp_knot_s_[hi] < s) ++hi;
+    const Scalar span = ramp_knot_s_[hi] - ramp_knot_s_[hi - 1];
+    const Scalar w = span > Scalar(0) ? std::clamp((s - ramp_knot_s_[hi - 1]) / span, Scalar(0), Scalar(1)) : Scalar(1);
+    return ramp_knots_[hi - 1] + w * (ramp_knots_[hi] - ramp_knots_[hi - 1]);
+  }
+
   /// Curvature coefficients of the current path at control step `step` (linear between knots).
   Coefficients coefficients_at(long step) {
     if (!tracking_) return statics_.coefficients();
@@ -756,6 +872,11 @@ class ModelExecutor {
   static constexpr int ramp_samples = 24;
   int ramp_steps_ = 0;
   Scalar ramp_path_ = 0;
+  std::array<Array3, 2> ramp_nodes_;  ///< node positions of successive ramp samples (set_target)
+  static constexpr int max_ramp_knots = 17;  // 2^ramp_via_depth + 1, depth at most 4
+  std::array<Coefficients, max_ramp_knots> ramp_knots_{};  // the ramp's shapes (start, vias, end)
+  std::array<Scalar, max_ramp_knots> ramp_knot_s_{};       // their blend parameters in [0, 1]
+  int ramp_knot_count_ = 2;
   long steps_ = 0;
   Array3 positions_, velocities_;
   Eigen::Matrix<Scalar, Eigen::Dynamic, 1> node_mass_;
