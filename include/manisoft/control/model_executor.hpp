@@ -141,12 +141,12 @@ struct ModelExecutorSettings {
   /// The defaults with a smooth shape ramp (issue 10's transient limits: no node faster than
   /// 1.5 m/s, no tip path longer than 1.5 x the straight distance): the planned peak node speed
   /// bounded by `max_node_step` (m per control step), via shapes where a blend's tip path exceeds
-  /// 1.3 x its straight distance, the cruise timing (peak 1.33 x the mean speed), and ramps up to
+  /// 1.2 x its straight distance, the cruise timing (peak 1.33 x the mean speed), and ramps up to
   /// `max_ramp` control steps long. Slower than the default ramp (BENCHMARKS.md, "Executor").
   static ModelExecutorSettings smooth_ramp(Scalar max_node_step, int max_ramp) {
     ModelExecutorSettings s;
     s.ramp_max_node_step = max_node_step;
-    s.ramp_path_ratio = Scalar(1.3);
+    s.ramp_path_ratio = Scalar(1.2);
     s.ramp_cruise = Scalar(0.5);
     s.max_ramp_steps = std::max(max_ramp, s.ramp_steps);
     return s;
@@ -766,8 +766,8 @@ class ModelExecutor {
 
   /// Appends the ramp's knots from shape a (the last knot) to shape b. A blend whose tip path is
   /// longer than ramp_path_ratio x the straight distance of its ends gets a via shape: the
-  /// blend's midpoint shape, its tip moved to the straight line's midpoint (or 0.6, 0.3 of the
-  /// way there) and re-solved near it (solve_near, else solve_from), kept when within the
+  /// blend's midpoint shape, its tip moved to the straight line's midpoint (or 0.8, 0.6, 0.45,
+  /// 0.3, 0.15 of the way there) and re-solved near it (solve_near, else solve_from), kept when within the
   /// limits and the two blends through it are shorter; each half is checked again, at most
   /// ramp_via_depth halvings deep.
   void add_ramp_segment(const Coefficients& a, const Coefficients& b, int depth) {
@@ -777,7 +777,7 @@ class ModelExecutor {
       if (path > settings_.ramp_path_ratio * (pb - pa).norm() + Scalar(1e-3)) {
         const Coefficients mid = Scalar(0.5) * (a + b);
         const Pose blend_mid = statics_.tip_pose(mid);
-        for (const Scalar pull : {Scalar(1), Scalar(0.6), Scalar(0.3)}) {
+        for (const Scalar pull : {Scalar(1), Scalar(0.8), Scalar(0.6), Scalar(0.45), Scalar(0.3), Scalar(0.15)}) {
           const Pose via{blend_mid.rotation, blend_mid.translation + pull * (Scalar(0.5) * (pa + pb) - blend_mid.translation)};
           auto r = statics_.solve_near(via, mid, 20);
           if (!r.within_limits) r = statics_.solve_from(via, mid);
