@@ -191,10 +191,12 @@ TEST_CASE("the model executor reaches and holds table targets", "[executor][reac
 }
 
 TEST_CASE("a smooth shape ramp: via shapes shorten a looping blend, node speeds and the tip path stay within issue 10's limits", "[executor][reach]") {
-  // reach_eval's table target 23 of seed 1 (tool down 0.6 m in front of the base): the single
-  // blend from the straight arm loops (tip path about 2.5 x the straight distance); via shapes
-  // pulled onto the straight line shorten it, and the node-speed bound and cruise timing keep
-  // every node under issue 10's 1.5 m/s (reach_eval --max-node-speed sets the same).
+  // reach_eval's table target 23 of seed 1. With g++ -O3 solve_cold finds an end shape whose
+  // single blend from the straight arm loops (tip path 2.5 x the straight distance); clang -O1
+  // draws and solves it differently (1.4 x): which branch is found depends on round-off. Via
+  // shapes pulled onto the straight line never lengthen the ramp and shorten a loop; the
+  // node-speed bound and cruise timing keep every node under issue 10's 1.5 m/s
+  // (reach_eval --max-node-speed sets the same).
   manisoft::env::ReachEnv<manisoft::rod::damping::AnalyticalLinear> env({}, manisoft::rod::damping::AnalyticalLinear<double>(0.1));
   const std::uint64_t seed = 1 * 1000003ull + 23;
   const Pose target = env.draw_target(seed);
@@ -202,13 +204,12 @@ TEST_CASE("a smooth shape ramp: via shapes shorten a looping blend, node speeds 
   const Eigen::Vector3d straight_tip = plain.statics().desired_tip_pose().translation;
   const double straight = (target.translation - straight_tip).norm();
   REQUIRE(plain.set_target(target).within_limits);
-  CHECK(plain.ramp_path() > 2 * straight);
-
   const auto settings = control::ModelExecutorSettings<double>::smooth_ramp(1.25 * env.config().dt * env.config().substeps, 1300);
   control::ModelExecutor<double> smooth(env.nominal_model(), env.config().limits, settings);
   REQUIRE(smooth.set_target(target).within_limits);
   CAPTURE(straight, plain.ramp_path(), smooth.ramp_path(), smooth.ramp_length());
-  CHECK(smooth.ramp_path() < 1.35 * straight);
+  CHECK(smooth.ramp_path() < 1.01 * plain.ramp_path());  // (sampled at other points along the same blend when no via is put in)
+  if (plain.ramp_path() > 2 * straight) CHECK(smooth.ramp_path() < 1.35 * straight);
   CHECK(smooth.ramp_length() > plain.ramp_length());
 
   double fastest = 0, path = 0;
