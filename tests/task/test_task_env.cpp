@@ -230,6 +230,35 @@ TEST_CASE("the expert solves fixed clean scenes within the horizon", "[tasks][ex
   CHECK(solved >= 3);
 }
 
+TEST_CASE("the open fingers come down onto a tall object from above and do not knock it over", "[tasks][expert]") {
+  // COLL clean 3: a cup (9 cm tall) 0.45 m from the home pose, whose annotated approach pose
+  // leaves the open fingertips 5 mm below its rim. A level approach swept the fingers into it and
+  // tipped it by 1 rad before the grasp. The expert now comes in above it (its via point raised
+  // until the fingertips pass 2 cm over the rim) and descends straight onto it: upright, unmoved
+  // and held.
+  const SceneSpec s = sample(Task::coll, 3);
+  const std::size_t cup = static_cast<std::size_t>(s.goal.object);
+  REQUIRE(s.objects.at(cup).asset_id.rfind("cup/", 0) == 0);
+  TaskEnv& e = env();
+  Expert expert(e);
+  e.reset(s);
+  const auto start = e.snapshot().objects[cup].pose;
+  double tilt = 0, shift = 0;
+  bool held = false;
+  run_expert(e, expert, s, 100000, [&](manisoft::task::ExpertPhase phase) {
+    const auto now = e.snapshot().objects[cup].pose;
+    if (phase == manisoft::task::ExpertPhase::approach || phase == manisoft::task::ExpertPhase::descend) {
+      tilt = std::max(tilt, std::acos(std::clamp(now.rotation.col(2).dot(start.rotation.col(2)), -1.0, 1.0)));
+      shift = std::max(shift, (now.translation - start.translation).norm());
+    }
+    if (phase == manisoft::task::ExpertPhase::carry) held = true;
+  });
+  CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure));
+  CHECK(tilt < 0.02);
+  CHECK(shift < 0.003);
+  CHECK(held);
+}
+
 TEST_CASE("the expert descends to a tight grasp slowly and stacks two plates", "[tasks][expert]") {
   // STK clean 2: two plates, whose grasps leave less than tight_clearance between each open finger
   // and the rim. A fast descent sways the arm sideways by about as much and tips the plate.

@@ -257,27 +257,37 @@ class Expert {
   double top_of(int object) const { return state_of(object).pose.act(Vec3(0, 0, scene::asset_height(asset_of(object)))).z(); }
 
   /// The approach leg from the end-effector pose `from` (the annotation's approach pose last).
-  /// "via": level to above the approach pose first, for a tall object (is_tall()) high enough
-  /// that the fingertips pass approach_tip_clearance above its top, then straight down.
+  /// "via": to above the approach pose first, then straight down; for a tall object (is_tall())
+  /// high enough that the fingertips pass approach_tip_clearance above its top, and raised by
+  /// another approach_raise_step (up to approach_raise_steps times) while the line there would
+  /// still bring the open fingers into its reach (approach_clear(): a line that climbs from a
+  /// lower start enters that reach before it is high enough).
   void set_approach_leg(Plan& p, const Pose& approach, const Pose& from) const {
-    p.approach_leg.clear();
     p.start = from;
-    Pose prev = from;
-    if (p.via_approach) {
-      Pose above = approach;
-      above.translation.z() = std::max(approach.translation.z(), from.translation.z());
-      if (is_tall(p.object))
-        above.translation.z() = std::max(above.translation.z(), approach.translation.z() + top_of(p.object) + config_.approach_tip_clearance - fingertips(approach).z());
-      append_leg(p.approach_leg, prev, above);
-      prev = above;
+    Pose above = approach;
+    above.translation.z() = std::max(approach.translation.z(), from.translation.z());
+    const bool tall = p.via_approach && is_tall(p.object);
+    if (tall)
+      above.translation.z() = std::max(above.translation.z(), approach.translation.z() + top_of(p.object) + config_.approach_tip_clearance - fingertips(approach).z());
+    for (int raise = 0;; ++raise) {
+      p.approach_leg.clear();
+      Pose prev = from;
+      if (p.via_approach) {
+        append_leg(p.approach_leg, prev, above);
+        prev = above;
+      }
+      append_leg(p.approach_leg, prev, approach);
+      if (!tall || raise == approach_raise_steps || approach_clear(p)) return;
+      above.translation.z() += approach_raise_step;
     }
-    append_leg(p.approach_leg, prev, approach);
   }
   /// Whether the approach leg keeps the open fingers off a tall object (is_tall(); a low one
   /// does not tip over): sampled along each line (positions linear, the line's end orientation),
   /// wherever the fingertips are lower than approach_tip_clearance above its top, the gripper's
-  /// axis is either over it (it is between the fingers whichever way they turn) or out of the
-  /// fingers' reach of it.
+  /// axis is either over it (it is between the fingers whichever way they turn), out of the
+  /// fingers' reach of it, or where it is at the approach pose (the straight descent onto the
+  /// annotated grasp, which straddles the object as annotated, also when its footprint's
+  /// circumscribed circle is wider than the opening).
   bool approach_clear(const Plan& p) const {
     if (!is_tall(p.object)) return true;
     const auto& gp = env_->gripper_parameters();
@@ -286,6 +296,8 @@ class Expert {
     const double between = 0.5 * gp.open_width - r;
     const double reach = r + std::hypot(0.5 * gp.open_width + gp.finger_thickness, gp.finger_half_width);
     constexpr int samples = 16;
+    constexpr double straddle = 0.005;  // m: fingertips this near (horizontally) to where they are at the approach pose
+    const Eigen::Vector2d last = fingertips(p.approach_leg.pose[static_cast<std::size_t>(p.approach_leg.count - 1)]).head<2>();
     Pose prev = p.start;
     for (int i = 0; i < p.approach_leg.count; ++i) {
       const Pose& to = p.approach_leg.pose[static_cast<std::size_t>(i)];
@@ -294,7 +306,7 @@ class Expert {
         x.translation = prev.translation + (double(k) / samples) * (to.translation - prev.translation);
         const Vec3 tips = fingertips(x);
         const double d = (tips.head<2>() - axis).norm();
-        if (tips.z() < top + config_.approach_tip_clearance && d > between && d < reach) return false;
+        if (tips.z() < top + config_.approach_tip_clearance && d > between && d < reach && (tips.head<2>() - last).norm() > straddle) return false;
       }
       prev = to;
     }
@@ -546,10 +558,10 @@ class Expert {
   bool check_line(const Pose& to, const char*& why) {
     planner_backup_ = planner_;
     const Pose from = planner_.statics().desired_tip_pose();
-    const auto report = planner_.track_line(to, 100, std::numeric_limits<double>::infinity(), config_.path_cruise);
+    const auto report = planner_.track_line(to, line_steps((to.translation - from.translation).norm(), check_held_), node_step(check_held_), config_.path_cruise);
     bool clear = report.accepted && held_line_clear(from, to);
     for (int k = 1; k <= line_samples && report.accepted && clear; ++k) {
-      planner_.predicted_shape(100 * k / line_samples, shape_);
+      planner_.predicted_shape(long(report.steps) * k / line_samples, shape_);
       clear = arm_clear(shape_);
     }
     planner_.complete_path();
@@ -725,14 +737,9 @@ class Expert {
   /// Starts the path to `goal`; a refused one ends the episode's plan (give_up) when `required`.
   bool start_path(const Pose& goal, bool required = true, double peak_speed = 0) {
     const double distance = (goal.translation - executor_.statics().desired_tip_pose().translation).norm();
-    const double control_dt = env_->control_dt();
     const bool loaded = s_ == 1;
-    const double peak = peak_speed > 0 ? peak_speed : loaded ? config_.carry_peak_speed : config_.path_peak_speed;
-    const double node = loaded ? config_.carry_node_speed : config_.max_node_speed;
-    // peak speed / mean speed of the timing
-    const double peak_ratio = config_.path_cruise > 0 ? 2 / (1 + config_.path_cruise) : 1.875;
-    const int steps = std::max(config_.min_segment_steps, static_cast<int>(std::ceil(peak_ratio * distance / peak / control_dt)));
-    const auto report = executor_.track_line(goal, steps, node * control_dt, config_.path_cruise);
+    const int steps = line_steps(distance, loaded, peak_speed);
+    const auto report = executor_.track_line(goal, steps, node_step(loaded), config_.path_cruise);
     if (!report.accepted) {
       // the executor's shape ramp to the goal's cold solution instead, when it has one
       if (config_.ramp_fallback && start_ramp(goal)) return true;
@@ -742,6 +749,17 @@ class Expert {
     target_ = goal;
     return true;
   }
+
+  /// Control steps of a line `distance` long at its peak end-effector speed (`peak_speed`, or
+  /// the configured one with the gripper empty or holding), before the node speed bound.
+  int line_steps(double distance, bool loaded, double peak_speed = 0) const {
+    const double peak = peak_speed > 0 ? peak_speed : loaded ? config_.carry_peak_speed : config_.path_peak_speed;
+    // peak speed / mean speed of the timing
+    const double peak_ratio = config_.path_cruise > 0 ? 2 / (1 + config_.path_cruise) : 1.875;
+    return std::max(config_.min_segment_steps, static_cast<int>(std::ceil(peak_ratio * distance / peak / env_->control_dt())));
+  }
+  /// The node speed bound of a line, m per control step.
+  double node_step(bool loaded) const { return (loaded ? config_.carry_node_speed : config_.max_node_speed) * env_->control_dt(); }
 
   /// Starts the executor's shape ramp to `goal` (set_target); false (nothing changed but the
   /// executor's target) when the goal has no inverse statics solution within the limits.
@@ -954,6 +972,8 @@ class Expert {
   const TaskEnv* env_;
   ExpertConfig config_;
   Executor executor_, planner_, planner_backup_;
+  static constexpr int approach_raise_steps = 10;   ///< set_approach_leg: raises of a tall object's via point
+  static constexpr double approach_raise_step = 0.01;  ///< m
   static constexpr int line_samples = 8;  ///< shapes checked along a planned line (arm_clear)
   double arm_margin_;                      ///< m: the rod's radius + arm_clearance (arm_clear)
   Array3 shape_;
