@@ -27,10 +27,10 @@
 // with no clear candidate is given up.
 // Waypoints of a move (the end-effector frame; straight lines with quintic timing, or a cruise
 // at constant speed over path_cruise of the line: ModelExecutor::track_line): approach (along
-// the annotation's approach direction, approach_distance from the grasp; "via": first level to
-// above it, for a tall object high enough that the fingertips pass approach_tip_clearance above
-// its top; candidates whose approach would sweep the open fingers into a tall object come last:
-// approach_clear()), grasp (at lower_peak_speed when the grasp is tight: tight_clearance), close once settled
+// the annotation's approach direction, approach_distance from the grasp; "via": first to above
+// it, for a tall object high enough that the fingertips pass approach_tip_clearance above its top,
+// and higher while the line there would still sweep them into it; candidates whose approach would
+// sweep the open fingers into a tall object come last: approach_clear()), grasp (at lower_peak_speed when the grasp is tight: tight_clearance), close once settled
 // (the arm's tip slower than settle_speed), carry (above the place pose, diagonal from the grasp;
 // "via": first straight up by lift_height, or until the object's bottom is 2 x held_clearance
 // above every other object and obstacle near its course: corridor_top), place (corrected for
