@@ -63,7 +63,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -261,8 +260,8 @@ class Expert {
   /// high enough that the fingertips pass approach_tip_clearance above its top, and raised by
   /// another approach_raise_step (up to approach_raise_steps times) while the line there would
   /// still bring the open fingers into its reach (approach_clear(): a line that climbs from a
-  /// lower start enters that reach before it is high enough).
-  void set_approach_leg(Plan& p, const Pose& approach, const Pose& from) const {
+  /// lower start enters that reach before it is high enough). Returns approach_clear() of the leg.
+  bool set_approach_leg(Plan& p, const Pose& approach, const Pose& from) const {
     p.start = from;
     Pose above = approach;
     above.translation.z() = std::max(approach.translation.z(), from.translation.z());
@@ -277,7 +276,8 @@ class Expert {
         prev = above;
       }
       append_leg(p.approach_leg, prev, approach);
-      if (!tall || raise == approach_raise_steps || approach_clear(p)) return;
+      const bool clear = approach_clear(p);
+      if (clear || !tall || raise == approach_raise_steps) return clear;
       above.translation.z() += approach_raise_step;
     }
   }
@@ -512,11 +512,11 @@ class Expert {
             sink_into_container(p);
             p.via_approach = variant & 1;
             p.via_carry = variant & 2;
-            set_approach_leg(p, now * about_axis * approach_pose(g) * half, from);
+            const bool clear = set_approach_leg(p, now * about_axis * approach_pose(g) * half, from);
             set_carry_leg(p);
             // least turning first, then the fewest lines
             // (approaches that would sweep the fingers into a tall object last)
-            const double cost = std::max(turn_from_home(p.grasp), turn_from_home(p.place)) + 1e-3 * variant + (approach_clear(p) ? 0.0 : 10.0);
+            const double cost = std::max(turn_from_home(p.grasp), turn_from_home(p.place)) + 1e-3 * variant + (clear ? 0.0 : 10.0);
             candidates.push_back({cost, p});
           }
         }
