@@ -97,7 +97,9 @@ class Worker {
       ms::dataset::EpisodeRecorder recorder(env_);
       ms::task::TaskEnv::Array3 torques;
       int s = 0;
-      while (!env_.done()) {
+      // A draw ends when the episode does or when the expert gives up: an episode it no longer
+      // drives is not kept, so its remaining steps until the horizon would be spent for nothing.
+      while (!env_.done() && !expert_.failure()[0]) {
         expert_.act(torques, s);
         recorder.step(torques, s);
         env_.step(torques, s);

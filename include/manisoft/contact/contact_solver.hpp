@@ -40,9 +40,14 @@
 #include "manisoft/contact/contact_manifold.hpp"
 
 #include <numbers>
+#include <span>
 #include <vector>
 
 namespace manisoft::contact {
+
+/// The manifolds the solver works on: those with points and a moving body (ContactManifold::active),
+/// in the world's manifold order.
+using ActiveManifolds = std::span<ContactManifold* const>;
 
 /// Velocity-level view of a body for the solver (inverse mass/inertia 0 = immovable this step).
 struct SolverBody {
@@ -99,10 +104,10 @@ inline void apply_angular_impulse(SolverBody& a, SolverBody& b, const Vec3& angu
 /// Prepare: world anchors, current separation, effective masses, restitution speed; friction
 /// state projected on the current tangent basis.
 template <typename BodyStates>
-void prepare_contacts(std::vector<ContactManifold>& manifolds, const BodyStates& states,
+void prepare_contacts(ActiveManifolds manifolds, const BodyStates& states,
                       const std::vector<SolverBody>& bodies) {
-  for (auto& m : manifolds) {
-    if (!m.active) continue;
+  for (ContactManifold* active : manifolds) {
+    auto& m = *active;
     const auto& sa = states[m.body_a];
     const auto& sb = states[m.body_b];
     const auto& ba = bodies[m.body_a];
@@ -181,9 +186,9 @@ void prepare_contacts(std::vector<ContactManifold>& manifolds, const BodyStates&
   }
 }
 
-inline void warm_start_contacts(std::vector<ContactManifold>& manifolds, std::vector<SolverBody>& bodies) {
-  for (auto& m : manifolds) {
-    if (!m.active) continue;
+inline void warm_start_contacts(ActiveManifolds manifolds, std::vector<SolverBody>& bodies) {
+  for (ContactManifold* active : manifolds) {
+    auto& m = *active;
     auto& ba = bodies[m.body_a];
     auto& bb = bodies[m.body_b];
     double total = 0;
@@ -204,11 +209,11 @@ inline void warm_start_contacts(std::vector<ContactManifold>& manifolds, std::ve
 
 /// One Gauss-Seidel pass over all manifolds: patch friction first (it uses the current normal
 /// impulses), then non-penetration point by point. `use_bias` = soft solve; false = relax.
-inline void solve_contacts(std::vector<ContactManifold>& manifolds, std::vector<SolverBody>& bodies,
+inline void solve_contacts(ActiveManifolds manifolds, std::vector<SolverBody>& bodies,
                            const ContactSolverSettings& s, bool use_bias) {
   const double inv_h = 1.0 / s.h;
-  for (auto& m : manifolds) {
-    if (!m.active) continue;
+  for (ContactManifold* active : manifolds) {
+    auto& m = *active;
     auto& ba = bodies[m.body_a];
     auto& bb = bodies[m.body_b];
     const Vec3& n = m.normal;
@@ -307,10 +312,10 @@ inline void solve_contacts(std::vector<ContactManifold>& manifolds, std::vector<
 
 /// Between the solve and the relax pass, after positions moved by h v: the separation the relax
 /// pass sees (s + h v_n) and the slip added to the static-friction drift (reset when sliding).
-inline void update_after_position_integration(std::vector<ContactManifold>& manifolds, std::vector<SolverBody>& bodies,
+inline void update_after_position_integration(ActiveManifolds manifolds, std::vector<SolverBody>& bodies,
                                               const ContactSolverSettings& s) {
-  for (auto& m : manifolds) {
-    if (!m.active) continue;
+  for (ContactManifold* active : manifolds) {
+    auto& m = *active;
     const auto& ba = bodies[m.body_a];
     const auto& bb = bodies[m.body_b];
     double total_normal = 0;
@@ -334,10 +339,11 @@ inline void update_after_position_integration(std::vector<ContactManifold>& mani
   }
 }
 
-inline void apply_restitution(std::vector<ContactManifold>& manifolds, std::vector<SolverBody>& bodies,
+inline void apply_restitution(ActiveManifolds manifolds, std::vector<SolverBody>& bodies,
                               const ContactSolverSettings& s) {
-  for (auto& m : manifolds) {
-    if (!m.active || m.restitution == 0) continue;
+  for (ContactManifold* active : manifolds) {
+    auto& m = *active;
+    if (m.restitution == 0) continue;
     auto& ba = bodies[m.body_a];
     auto& bb = bodies[m.body_b];
     for (int k = 0; k < m.count; ++k) {
@@ -353,9 +359,9 @@ inline void apply_restitution(std::vector<ContactManifold>& manifolds, std::vect
 }
 
 /// Store: keep the accumulated impulses and drift (world vectors) for the next step.
-inline void store_impulses(std::vector<ContactManifold>& manifolds, const ContactSolverSettings& s) {
-  for (auto& m : manifolds) {
-    if (!m.active) continue;
+inline void store_impulses(ActiveManifolds manifolds, const ContactSolverSettings& s) {
+  for (ContactManifold* active : manifolds) {
+    auto& m = *active;
     auto& f = m.patch;
     if (!s.warm_start) {
       for (int k = 0; k < m.count; ++k) m.points[static_cast<std::size_t>(k)].normal_impulse = 0;

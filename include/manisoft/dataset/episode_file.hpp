@@ -4,12 +4,12 @@
 //                                  (task, setting, scene JSON, instructions JSON, ...) and every
 //                                  Episode::numbers entry (success, seed, ...)
 //   /data/demo_<k>/actions         float64 T x (3 n + 1): element torques row by row, then S
-//                                  (actions, states and obs arrays: byte shuffle + gzip, chunks
-//                                  of 256 steps; about 3/4 of the raw size)
+//                                  (actions and states: byte shuffle + gzip, chunks of 256
+//                                  steps; about 3/4 of the raw size)
 //   /data/demo_<k>/states          float64 T x D: the state before each action (replay)
 //   /data/demo_<k>/rewards         float64 T
 //   /data/demo_<k>/dones           uint8 T
-//   /data/demo_<k>/obs/<name>      float64 T x k, and images taken at every step as uint8
+//   /data/demo_<k>/obs/<name>      float32 T x k (uncompressed), and images taken at every step as uint8
 //                                  T x H x W x 3 (one gzip-compressed chunk a frame: h5py reads
 //                                  them without any decoder)
 //   /data/demo_<k>/images/<name>   image sequences taken every K steps: uint8 F x H x W x 3, with
@@ -59,7 +59,13 @@ inline void write_episode(const std::filesystem::path& path, const Episode& epis
     write_array("/states", episode.states);
     file.write(demo + "/rewards", {t}, episode.rewards.data());
     file.write(demo + "/dones", {t}, episode.dones.data());
-    for (const auto& [name, m] : episode.observations) write_array("/obs/" + name, m);
+    // Observations as float32 (what a policy trains on; the float64 states replay exactly),
+    // uncompressed: smaller than shuffled + gzipped float64 and free to write and read.
+    std::vector<float> narrowed;
+    for (const auto& [name, m] : episode.observations) {
+      narrowed.assign(m.data(), m.data() + m.size());
+      file.write(demo + "/obs/" + name, {t, static_cast<hsize_t>(m.cols())}, narrowed.data());
+    }
     for (const auto& [name, seq] : episode.images) {
       const std::vector<hsize_t> shape{static_cast<hsize_t>(seq.frames), static_cast<hsize_t>(seq.height),
                                        static_cast<hsize_t>(seq.width), 3};
@@ -124,7 +130,7 @@ inline Episode read_episode(const std::filesystem::path& path, long index) {
   };
   for (const std::string& name : file.children(demo + "/obs")) {
     const std::string at = demo + "/obs/" + name;
-    const std::vector<hsize_t> s = file.shape(at);  // images are 4-D uint8, the rest 2-D float64
+    const std::vector<hsize_t> s = file.shape(at);  // images are 4-D uint8, the rest 2-D float32
     if (s.size() == 4) {
       std::vector<std::int64_t> steps(s[0]);
       for (std::size_t f = 0; f < steps.size(); ++f) steps[f] = static_cast<std::int64_t>(f);

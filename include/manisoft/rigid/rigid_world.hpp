@@ -166,6 +166,7 @@ class RigidWorld {
     island_min_time_.reserve(bodies);
     pairs_.reserve(std::min(g * (g - 1) / 2, 16 * g));
     record_.list.reserve(pairs_.capacity());
+    active_.reserve(pairs_.capacity());
     record_.manifolds.reserve(2 * pairs_.capacity());
     return id;
   }
@@ -254,20 +255,26 @@ class RigidWorld {
         b.inv_inertia = s.rotation * m.inverse_inertia * s.rotation.transpose();
       }
     }
+    // The solver's passes visit only the active manifolds (a nested stack has hundreds of pairs,
+    // few of them touching and moving), in list order.
+    active_.clear();
+    if (active_.capacity() < manifolds_.size()) active_.reserve(manifolds_.capacity());
     for (std::size_t i = 0; i < manifolds_.size(); ++i) {
       auto& m = manifolds_[i];
       m.active = m.count > 0 && (is_moving(m.body_a) || is_moving(m.body_b));
-      if (m.active) record_manifold(i);  // its impulses and friction drift change below
+      if (!m.active) continue;
+      record_manifold(i);  // its impulses and friction drift change below
+      active_.push_back(&m);
     }
-    contact::prepare_contacts(manifolds_, states_, solver_bodies_);
+    contact::prepare_contacts(active_, states_, solver_bodies_);
     integrate_velocities(dt);
-    if (settings_.warm_start) contact::warm_start_contacts(manifolds_, solver_bodies_);
-    for (int it = 0; it < settings_.solve_iterations; ++it) contact::solve_contacts(manifolds_, solver_bodies_, cs, true);
+    if (settings_.warm_start) contact::warm_start_contacts(active_, solver_bodies_);
+    for (int it = 0; it < settings_.solve_iterations; ++it) contact::solve_contacts(active_, solver_bodies_, cs, true);
     integrate_positions(dt);
-    contact::update_after_position_integration(manifolds_, solver_bodies_, cs);
-    for (int it = 0; it < settings_.relax_iterations; ++it) contact::solve_contacts(manifolds_, solver_bodies_, cs, false);
-    contact::apply_restitution(manifolds_, solver_bodies_, cs);
-    contact::store_impulses(manifolds_, cs);
+    contact::update_after_position_integration(active_, solver_bodies_, cs);
+    for (int it = 0; it < settings_.relax_iterations; ++it) contact::solve_contacts(active_, solver_bodies_, cs, false);
+    contact::apply_restitution(active_, solver_bodies_, cs);
+    contact::store_impulses(active_, cs);
     finish_step(dt);
   }
 
@@ -467,12 +474,16 @@ class RigidWorld {
   }
 
  private:
+  /// Broad-phase callback: keeps the pairs that can touch (two bodies, not both static). A
+  /// compound's own pieces overlap each other and would otherwise be most of the list.
   static bool collect_pair(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
-    auto* pairs = static_cast<std::vector<std::uint64_t>*>(data);
+    auto* world = static_cast<RigidWorld*>(data);
     auto a = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(o1->getUserData()) - 1);
     auto b = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(o2->getUserData()) - 1);
+    const BodyId ba = world->geoms_[a].body, bb = world->geoms_[b].body;
+    if (ba == bb || (world->models_[ba].is_static && world->models_[bb].is_static)) return false;
     if (a > b) std::swap(a, b);
-    pairs->push_back((std::uint64_t(a) << 32) | b);
+    world->pairs_.push_back((std::uint64_t(a) << 32) | b);
     return false;
   }
   static bool collect_query(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
@@ -527,15 +538,19 @@ class RigidWorld {
     if (!broadphase_dirty_) return;
     broadphase_dirty_ = false;
     pairs_.clear();
-    manager_->collide(&pairs_, &collect_pair);
+    manager_->collide(this, &collect_pair);
     std::sort(pairs_.begin(), pairs_.end());
+    // A fat box that moved usually leaves the pair set as it was (a carried object in free air):
+    // then the manifold list stays, uncopied (nested compounds have hundreds of pairs).
+    if (pairs_.size() == manifolds_.size() &&
+        std::equal(pairs_.begin(), pairs_.end(), manifolds_.begin(), [](std::uint64_t key, const contact::ContactManifold& m) { return key == m.key(); }))
+      return;
     // Merge into the sorted manifold list, keeping the cache of persisting pairs.
     next_manifolds_.clear();
     std::size_t old = 0;
     for (const auto key : pairs_) {
       const auto ga = static_cast<std::uint32_t>(key >> 32), gb = static_cast<std::uint32_t>(key & 0xffffffffu);
       const BodyId ba = geoms_[ga].body, bb = geoms_[gb].body;
-      if (ba == bb || (models_[ba].is_static && models_[bb].is_static)) continue;
       while (old < manifolds_.size() && manifolds_[old].key() < key) ++old;
       if (old < manifolds_.size() && manifolds_[old].key() == key) {
         next_manifolds_.push_back(manifolds_[old]);
@@ -763,6 +778,7 @@ class RigidWorld {
   std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> manager_;
   bool broadphase_dirty_{true};
   std::vector<std::uint64_t> pairs_;
+  std::vector<contact::ContactManifold*> active_;  // this step's active manifolds (points into manifolds_)
   std::vector<contact::ContactManifold> manifolds_, next_manifolds_;
   std::vector<contact::SolverBody> solver_bodies_;
   std::vector<std::uint32_t> parent_;
