@@ -207,7 +207,7 @@ inline void warm_start_contacts(ActiveManifolds manifolds, std::vector<SolverBod
   }
 }
 
-/// One Gauss-Seidel pass over all manifolds: patch friction first (it uses the current normal
+/// One Gauss-Seidel pass over the active manifolds: patch friction first (it uses the current normal
 /// impulses), then non-penetration point by point. `use_bias` = soft solve; false = relax.
 inline void solve_contacts(ActiveManifolds manifolds, std::vector<SolverBody>& bodies,
                            const ContactSolverSettings& s, bool use_bias) {
