@@ -81,7 +81,7 @@ void check_read_back(const ds::Episode& a, const ds::Episode& b) {
 
 }  // namespace
 
-TEST_CASE("an episode written and read back is bit-identical", "[dataset]") {
+TEST_CASE("an episode written and read back is bit-identical (observations: to the nearest float32)", "[dataset]") {
   const fs::path dir = manisoft::test::scratch_dir("manisoft_dataset_roundtrip");
   const ds::Episode e = make_episode(3, 12, "COLL", "clean");
   ds::write_episode(dir / "demo_3.hdf5", e);

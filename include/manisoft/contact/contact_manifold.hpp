@@ -68,7 +68,6 @@ struct ContactManifold {
   bool rolling{false};              ///< last detection was a rolling contact (ContactSet::rolling)
   // Per step.
   Vec3 normal{Vec3::UnitZ()}, tangent1{Vec3::UnitX()}, tangent2{Vec3::UnitY()};
-  bool active{false};
 
   std::uint64_t key() const { return (std::uint64_t(geom_a) << 32) | geom_b; }
 };

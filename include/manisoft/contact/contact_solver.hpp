@@ -45,8 +45,8 @@
 
 namespace manisoft::contact {
 
-/// The manifolds the solver works on: those with points and a moving body (ContactManifold::active),
-/// in the world's manifold order.
+/// The manifolds the solver works on this step: those with points and a moving body, in the
+/// world's manifold order (RigidWorld builds the list).
 using ActiveManifolds = std::span<ContactManifold* const>;
 
 /// Velocity-level view of a body for the solver (inverse mass/inertia 0 = immovable this step).

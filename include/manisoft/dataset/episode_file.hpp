@@ -9,9 +9,9 @@
 //   /data/demo_<k>/states          float64 T x D: the state before each action (replay)
 //   /data/demo_<k>/rewards         float64 T
 //   /data/demo_<k>/dones           uint8 T
-//   /data/demo_<k>/obs/<name>      float32 T x k (uncompressed), and images taken at every step as uint8
-//                                  T x H x W x 3 (one gzip-compressed chunk a frame: h5py reads
-//                                  them without any decoder)
+//   /data/demo_<k>/obs/<name>      float32 T x k (uncompressed), and images taken at every
+//                                  step as uint8 T x H x W x 3 (one gzip-compressed chunk a
+//                                  frame: h5py reads them without any decoder)
 //   /data/demo_<k>/images/<name>   image sequences taken every K steps: uint8 F x H x W x 3, with
 //   /data/demo_<k>/images/<name>_steps  int64 F, the control step of each frame
 //

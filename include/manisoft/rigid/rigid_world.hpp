@@ -261,8 +261,7 @@ class RigidWorld {
     if (active_.capacity() < manifolds_.size()) active_.reserve(manifolds_.capacity());
     for (std::size_t i = 0; i < manifolds_.size(); ++i) {
       auto& m = manifolds_[i];
-      m.active = m.count > 0 && (is_moving(m.body_a) || is_moving(m.body_b));
-      if (!m.active) continue;
+      if (m.count == 0 || !(is_moving(m.body_a) || is_moving(m.body_b))) continue;
       record_manifold(i);  // its impulses and friction drift change below
       active_.push_back(&m);
     }
