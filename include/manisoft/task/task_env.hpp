@@ -56,6 +56,11 @@ struct TaskEnvConfig {
   int home_settle_steps = 300;            ///< then held
   int hold_steps = 10;                    ///< control steps the predicate must hold for success
   int observe_stride = 2;                 ///< every this many nodes in the executor's observation
+  /// s: an island of bodies slower than the rigid world's sleep speeds (5 mm/s, 0.05 rad/s) for
+  /// this long sleeps (rigid::RigidWorldSettings::time_to_sleep; its default 0.5 s is a quarter
+  /// of an episode, and a nested stack of plates awake is most of STK's cost). A sleeping body is
+  /// at rest in the predicates' sense too: it was slower than half their limits all that time.
+  double time_to_sleep = 0.1;
   Tolerances tolerances{};
   control::ModelExecutorSettings<double> executor{};
 };
@@ -199,6 +204,7 @@ class TaskEnv {
     if (c.hold_steps < 1) manisoft::detail::fail("TaskEnvConfig hold_steps = ", c.hold_steps, " must be >= 1");
     if (c.home_path_steps < 1) manisoft::detail::fail("TaskEnvConfig home_path_steps = ", c.home_path_steps, " must be >= 1");
     manisoft::detail::require_non_negative("TaskEnvConfig rod_damping", c.rod_damping);
+    manisoft::detail::require_positive("TaskEnvConfig time_to_sleep", c.time_to_sleep);
     if (!c.home.allFinite()) manisoft::detail::fail("TaskEnvConfig home is not finite");
     return c;
   }
@@ -206,6 +212,7 @@ class TaskEnv {
     world::ArmWorldSettings s;
     s.gripper = gripper_;
     s.substeps_per_control_step = config_.substeps;
+    s.rigid.time_to_sleep = config_.time_to_sleep;
     return s;
   }
   Rod make_rod() const { return Rod(params_, config_.dt, rod::damping::AnalyticalLinear<double>(config_.rod_damping)); }
