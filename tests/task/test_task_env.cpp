@@ -110,6 +110,38 @@ TEST_CASE("COLL: a cup released over the basket's opening falls in and the episo
   CHECK(cup.touches(s.goal.container));
 }
 
+TEST_CASE("bodies at rest sleep after the task world's time_to_sleep and still report their contacts", "[tasks][env]") {
+  // COLL clean 3: a cup and a basket standing on the table (the goal not met), the arm held at
+  // home for 250 control steps (0.35 s): they settle into the soft contact within a few steps.
+  const SceneSpec s = sample(Task::coll, 3);
+  const auto cup = static_cast<std::size_t>(s.goal.object);
+  SECTION("0.1 s (the default): asleep, velocities zero, still touching the table") {
+    TaskEnv& e = env();
+    REQUIRE(e.config().time_to_sleep == 0.1);
+    e.reset(s);
+    hold_home(e, 250);
+    REQUIRE_FALSE(e.done());
+    CHECK_FALSE(e.world().rigid().is_awake(e.bodies().objects[cup]));
+    const auto& o = e.snapshot().objects[cup];
+    CHECK(o.linear_velocity.norm() == 0.0);
+    CHECK(o.angular_velocity.norm() == 0.0);
+    CHECK(o.touches_table);  // the sleeping pair's manifold is kept: the predicates see the contact
+  }
+  SECTION("0.5 s: still awake after 0.35 s") {
+    manisoft::task::TaskEnvConfig c;
+    c.time_to_sleep = 0.5;
+    TaskEnv e(sampler().library(), c);
+    e.reset(s);
+    hold_home(e, 250);
+    CHECK(e.world().rigid().is_awake(e.bodies().objects[cup]));
+  }
+  SECTION("a time_to_sleep of 0 is refused") {
+    manisoft::task::TaskEnvConfig c;
+    c.time_to_sleep = 0;
+    CHECK_THROWS_WITH(TaskEnv(sampler().library(), c), Catch::Contains("time_to_sleep"));
+  }
+}
+
 TEST_CASE("episodes end for the documented reasons: goal already met, object off the table, horizon", "[tasks][env]") {
   TaskEnv& e = env();
   SECTION("a goal that holds at reset is an invalid scene: done before the first step") {

@@ -57,9 +57,9 @@ struct TaskEnvConfig {
   int hold_steps = 10;                    ///< control steps the predicate must hold for success
   int observe_stride = 2;                 ///< every this many nodes in the executor's observation
   /// s: an island of bodies slower than the rigid world's sleep speeds (5 mm/s, 0.05 rad/s) for
-  /// this long sleeps (rigid::RigidWorldSettings::time_to_sleep; its default 0.5 s is a quarter
-  /// of an episode, and a nested stack of plates awake is most of STK's cost). A sleeping body is
-  /// at rest in the predicates' sense too: it was slower than half their limits all that time.
+  /// this long sleeps (rigid::RigidWorldSettings::time_to_sleep, whose default 0.5 s is a quarter
+  /// of an episode: a nested stack stays in the contact solve that long). A sleeping body is at
+  /// rest in the predicates' sense too: it was slower than half their limits all that time.
   double time_to_sleep = 0.1;
   Tolerances tolerances{};
   control::ModelExecutorSettings<double> executor{};
