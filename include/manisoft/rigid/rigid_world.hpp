@@ -7,7 +7,8 @@
 // wake when a force is applied, a velocity or pose is set, or a moving body touches them.
 // Step order (symplectic Euler): contacts -> prepare -> v += h M^-1 f -> warm start -> solve ->
 // x += h v, q += h/2 w q -> relax -> restitution -> store.
-// Determinism: everything is iterated in body/geometry index order; broad-phase pairs are sorted.
+// Determinism: everything is iterated in body/geometry index order or in the order of the pairs'
+// keys (the solver sorts its active manifolds; the manifold list is in order of creation).
 // Allocation: after the first steps (buffers grown to their working size) step() allocates only
 // when the set of overlapping pairs grows beyond its previous maximum (the narrow phase works in
 // fixed-size buffers; query_capsule allocates only on first use).
@@ -156,6 +157,8 @@ class RigidWorld {
       manager_->registerObject(fcl_objects_[g].get());
     }
     broadphase_dirty_ = true;
+    moved_flag_.resize(geoms_.size(), 0);
+    moved_.reserve(geoms_.size());
     // Per-body step buffers at their working size now, so no step allocates for them; candidate
     // pairs get room for every pair of geoms (at most 16 per geom).
     const std::size_t bodies = models_.size(), g = geoms_.size();
@@ -165,7 +168,10 @@ class RigidWorld {
     parent_.reserve(bodies);
     island_min_time_.reserve(bodies);
     pairs_.reserve(std::min(g * (g - 1) / 2, 16 * g));
-    record_.list.reserve(pairs_.capacity());
+    old_pairs_.reserve(pairs_.capacity());
+    keys_.reserve(pairs_.capacity());
+    manifolds_.reserve(pairs_.capacity());
+    dropped_.reserve(pairs_.capacity());
     active_.reserve(pairs_.capacity());
     record_.manifolds.reserve(2 * pairs_.capacity());
     return id;
@@ -192,7 +198,7 @@ class RigidWorld {
   /// per-step rollback (what a step touches, not the whole world) that step() and the arm world use.
   void begin_step() {
     record_.states = states_;
-    record_.list_saved = false;
+    record_.ops.clear();
     record_.manifolds.clear();
     record_.boxes.clear();
     record_.broadphase_dirty = broadphase_dirty_;
@@ -204,11 +210,20 @@ class RigidWorld {
   void undo_step() {
     if (!recording_) ::manisoft::detail::fail("RigidWorld::undo_step without begin_step");
     states_ = record_.states;
-    if (record_.list_saved) {
-      manifolds_.resize(record_.list.size());
-      for (std::size_t i = 0; i < manifolds_.size(); ++i) manifolds_[i] = record_.list[i].manifold();
-    } else {
-      for (auto it = record_.manifolds.rbegin(); it != record_.manifolds.rend(); ++it) manifolds_[it->first] = it->second.manifold();
+    for (auto it = record_.manifolds.rbegin(); it != record_.manifolds.rend(); ++it) manifolds_[it->first] = it->second.manifold();
+    for (auto it = record_.ops.rbegin(); it != record_.ops.rend(); ++it) {
+      if (!it->removed) {  // an added pair: it is the last slot
+        manifolds_.pop_back();
+        keys_.pop_back();
+      } else if (it->slot == manifolds_.size()) {  // the last slot was removed
+        manifolds_.push_back(it->memory.manifold());
+        keys_.push_back(manifolds_.back().key());
+      } else {  // the last slot had moved into the removed one
+        manifolds_.push_back(manifolds_[it->slot]);
+        keys_.push_back(keys_[it->slot]);
+        manifolds_[it->slot] = it->memory.manifold();
+        keys_[it->slot] = manifolds_[it->slot].key();
+      }
     }
     for (auto it = record_.boxes.rbegin(); it != record_.boxes.rend(); ++it) {
       auto& geom = geoms_[it->geom];
@@ -265,6 +280,8 @@ class RigidWorld {
       record_manifold(i);  // its impulses and friction drift change below
       active_.push_back(&m);
     }
+    // The solver visits them in key order (the list's slots are in order of creation).
+    std::sort(active_.begin(), active_.end(), [](const contact::ContactManifold* a, const contact::ContactManifold* b) { return a->key() < b->key(); });
     contact::prepare_contacts(active_, states_, solver_bodies_);
     integrate_velocities(dt);
     if (settings_.warm_start) contact::warm_start_contacts(active_, solver_bodies_);
@@ -310,7 +327,11 @@ class RigidWorld {
       ::manisoft::detail::fail("RigidWorld::restore: the snapshot has ", in.states.size(), " bodies, the world ", states_.size());
     states_ = in.states;
     manifolds_.resize(in.manifolds.size());
-    for (std::size_t i = 0; i < manifolds_.size(); ++i) manifolds_[i] = in.manifolds[i].manifold();
+    keys_.resize(in.manifolds.size());
+    for (std::size_t i = 0; i < manifolds_.size(); ++i) {
+      manifolds_[i] = in.manifolds[i].manifold();
+      keys_[i] = manifolds_[i].key();
+    }
     for (std::uint32_t g = 0; g < geoms_.size(); ++g) {
       if (geoms_[g].fat_lo == in.fat_lo[g] && geoms_[g].fat_hi == in.fat_hi[g]) continue;
       geoms_[g].fat_lo = in.fat_lo[g];
@@ -485,6 +506,16 @@ class RigidWorld {
     world->pairs_.push_back((std::uint64_t(a) << 32) | b);
     return false;
   }
+  /// Broad-phase callback of one moved geom's query: as collect_pair; a pair of two moved geoms is
+  /// found by both queries and kept from the lower one's.
+  static bool collect_moved_pair(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
+    auto* world = static_cast<RigidWorld*>(data);
+    const auto a = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(o1->getUserData()) - 1);
+    const auto b = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(o2->getUserData()) - 1);
+    const auto other = a == world->query_geom_ ? b : a;
+    if (world->moved_flag_[other] && other < world->query_geom_) return false;
+    return collect_pair(o1, o2, data);
+  }
   static bool collect_query(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
     auto* out = static_cast<std::vector<std::uint32_t>*>(data);
     // One of the two is the query object (user data 0); the other carries geometry index + 1.
@@ -506,7 +537,7 @@ class RigidWorld {
 
   /// Keeps manifold i's memory from before this step (once the list was saved whole, that covers it).
   void record_manifold(std::size_t i) {
-    if (recording_ && !record_.list_saved) record_.manifolds.emplace_back(static_cast<std::uint32_t>(i), contact::ManifoldMemory::of(manifolds_[i]));
+    if (recording_) record_.manifolds.emplace_back(static_cast<std::uint32_t>(i), contact::ManifoldMemory::of(manifolds_[i]));
   }
 
   /// Recomputes the fat AABB of geometry g if its margin-inflated bounds left it (or if forced).
@@ -526,35 +557,66 @@ class RigidWorld {
     return true;
   }
 
+  /// The manifold list holds one manifold per overlapping pair of fat boxes (geoms of two bodies,
+  /// not both static), each in a fixed slot until its pair separates: a removed pair's slot takes
+  /// the last manifold, new pairs are appended. After a change the broad phase cannot follow (a new
+  /// body, a teleport, a restored snapshot marked dirty) the whole tree is collided with itself;
+  /// otherwise only the geoms whose fat box moved are queried, and only their pairs can change.
   void update_broadphase() {
+    moved_.clear();
     for (std::uint32_t g = 0; g < geoms_.size(); ++g) {
       if (!is_moving(geoms_[g].body)) continue;
       if (refresh_fat_bounds(g, false)) {
         manager_->update(fcl_objects_[g].get());
-        broadphase_dirty_ = true;
+        moved_.push_back(g);
       }
     }
-    if (!broadphase_dirty_) return;
-    broadphase_dirty_ = false;
+    if (!broadphase_dirty_ && moved_.empty()) return;
+    // pairs_: the overlapping pairs that this update decides; old_pairs_: the manifolds it may drop.
     pairs_.clear();
-    manager_->collide(this, &collect_pair);
+    old_pairs_.clear();
+    if (broadphase_dirty_) {
+      manager_->collide(this, &collect_pair);
+      for (std::uint32_t i = 0; i < keys_.size(); ++i) old_pairs_.push_back({keys_[i], i});
+    } else {
+      for (const auto g : moved_) moved_flag_[g] = 1;
+      for (std::uint32_t i = 0; i < keys_.size(); ++i) {
+        if (moved_flag_[keys_[i] >> 32] || moved_flag_[keys_[i] & 0xffffffffu]) old_pairs_.push_back({keys_[i], i});
+      }
+      for (const auto g : moved_) {
+        query_geom_ = g;
+        manager_->collide(fcl_objects_[g].get(), this, &collect_moved_pair);
+      }
+      for (const auto g : moved_) moved_flag_[g] = 0;
+    }
+    broadphase_dirty_ = false;
     std::sort(pairs_.begin(), pairs_.end());
-    // A fat box that moved usually leaves the pair set as it was (a carried object in free air):
-    // then the manifold list stays, uncopied (nested compounds have hundreds of pairs).
-    if (pairs_.size() == manifolds_.size() &&
-        std::equal(pairs_.begin(), pairs_.end(), manifolds_.begin(), [](std::uint64_t key, const contact::ContactManifold& m) { return key == m.key(); }))
-      return;
-    // Merge into the sorted manifold list, keeping the cache of persisting pairs.
-    next_manifolds_.clear();
-    std::size_t old = 0;
+    std::sort(old_pairs_.begin(), old_pairs_.end());
+    // Drop the manifolds whose pair is gone (highest slot first: the last slot, which takes the
+    // place of a removed one, is then never one still to remove).
+    dropped_.clear();
+    std::size_t j = 0;
+    for (const auto& [key, slot] : old_pairs_) {
+      while (j < pairs_.size() && pairs_[j] < key) ++j;
+      if (j == pairs_.size() || pairs_[j] != key) dropped_.push_back(slot);
+    }
+    std::sort(dropped_.begin(), dropped_.end(), std::greater<>());
+    for (const auto slot : dropped_) {
+      if (recording_) record_.ops.push_back({slot, true, contact::ManifoldMemory::of(manifolds_[slot])});
+      if (slot + 1 < manifolds_.size()) {
+        manifolds_[slot] = manifolds_.back();
+        keys_[slot] = keys_.back();
+      }
+      manifolds_.pop_back();
+      keys_.pop_back();
+    }
+    // Append the new pairs, in key order.
+    std::size_t o = 0;
     for (const auto key : pairs_) {
+      while (o < old_pairs_.size() && old_pairs_[o].first < key) ++o;
+      if (o < old_pairs_.size() && old_pairs_[o].first == key) continue;
       const auto ga = static_cast<std::uint32_t>(key >> 32), gb = static_cast<std::uint32_t>(key & 0xffffffffu);
       const BodyId ba = geoms_[ga].body, bb = geoms_[gb].body;
-      while (old < manifolds_.size() && manifolds_[old].key() < key) ++old;
-      if (old < manifolds_.size() && manifolds_[old].key() == key) {
-        next_manifolds_.push_back(manifolds_[old]);
-        continue;
-      }
       contact::ContactManifold m;
       m.geom_a = ga;
       m.geom_b = gb;
@@ -564,14 +626,10 @@ class RigidWorld {
       m.restitution = contact::mix_restitution(models_[ba].restitution, models_[bb].restitution);
       m.rolling_resistance = contact::mix_rolling_resistance(models_[ba].rolling_resistance, models_[bb].rolling_resistance);
       m.fresh = true;
-      next_manifolds_.push_back(m);
+      if (recording_) record_.ops.push_back({static_cast<std::uint32_t>(manifolds_.size()), false, {}});
+      manifolds_.push_back(m);
+      keys_.push_back(key);
     }
-    if (recording_ && !record_.list_saved) {
-      record_.list.resize(manifolds_.size());
-      for (std::size_t i = 0; i < manifolds_.size(); ++i) record_.list[i] = contact::ManifoldMemory::of(manifolds_[i]);
-      record_.list_saved = true;
-    }
-    std::swap(manifolds_, next_manifolds_);
   }
 
   void update_narrowphase() {
@@ -758,8 +816,12 @@ class RigidWorld {
   std::vector<RigidBodyState> states_;
   struct StepRecord {
     std::vector<RigidBodyState> states;
-    bool list_saved{false};
-    std::vector<contact::ManifoldMemory> list;
+    struct ListOp {  // a change of the manifold list, in order
+      std::uint32_t slot;
+      bool removed;                     // false: a manifold was appended at `slot`
+      contact::ManifoldMemory memory;  // the removed manifold
+    };
+    std::vector<ListOp> ops;
     std::vector<std::pair<std::uint32_t, contact::ManifoldMemory>> manifolds;
     struct Box {
       std::uint32_t geom;
@@ -776,9 +838,15 @@ class RigidWorld {
   std::vector<std::unique_ptr<detail::FatCollisionObject>> fcl_objects_;
   std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> manager_;
   bool broadphase_dirty_{true};
-  std::vector<std::uint64_t> pairs_;
+  std::vector<std::uint64_t> pairs_;                               // see update_broadphase
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> old_pairs_;  // (key, slot)
+  std::vector<std::uint64_t> keys_;                                // manifolds_[i].key(), compact
+  std::vector<std::uint32_t> dropped_;                             // slots whose pair separated
+  std::vector<std::uint32_t> moved_;   // geoms whose fat box moved this step
+  std::vector<char> moved_flag_;       // per geom: in moved_ (set only inside update_broadphase)
+  std::uint32_t query_geom_{0};        // the moved geom being queried
   std::vector<contact::ContactManifold*> active_;  // this step's active manifolds (points into manifolds_)
-  std::vector<contact::ContactManifold> manifolds_, next_manifolds_;
+  std::vector<contact::ContactManifold> manifolds_;
   std::vector<contact::SolverBody> solver_bodies_;
   std::vector<std::uint32_t> parent_;
   std::vector<double> island_min_time_;
