@@ -8,7 +8,7 @@
 // Step order (symplectic Euler): contacts -> prepare -> v += h M^-1 f -> warm start -> solve ->
 // x += h v, q += h/2 w q -> relax -> restitution -> store.
 // Determinism: everything is iterated in body/geometry index order or in the order of the pairs'
-// keys (the solver sorts its active manifolds; the manifold list is in order of creation).
+// keys (the solver sorts its active manifolds; the manifold list keeps each pair in a slot).
 // Allocation: after the first steps (buffers grown to their working size) step() allocates only
 // when the set of overlapping pairs grows beyond its previous maximum (the narrow phase works in
 // fixed-size buffers; query_capsule allocates only on first use).
@@ -25,6 +25,7 @@
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -172,6 +173,8 @@ class RigidWorld {
     keys_.reserve(pairs_.capacity());
     manifolds_.reserve(pairs_.capacity());
     dropped_.reserve(pairs_.capacity());
+    record_.ops.reserve(2 * pairs_.capacity());  // a step removes at most the old pairs, adds at most the new
+    record_.removed.reserve(pairs_.capacity());
     active_.reserve(pairs_.capacity());
     record_.manifolds.reserve(2 * pairs_.capacity());
     return id;
@@ -199,6 +202,7 @@ class RigidWorld {
   void begin_step() {
     record_.states = states_;
     record_.ops.clear();
+    record_.removed.clear();
     record_.manifolds.clear();
     record_.boxes.clear();
     record_.broadphase_dirty = broadphase_dirty_;
@@ -211,18 +215,22 @@ class RigidWorld {
     if (!recording_) ::manisoft::detail::fail("RigidWorld::undo_step without begin_step");
     states_ = record_.states;
     for (auto it = record_.manifolds.rbegin(); it != record_.manifolds.rend(); ++it) manifolds_[it->first] = it->second.manifold();
+    auto removed = record_.removed.rbegin();
     for (auto it = record_.ops.rbegin(); it != record_.ops.rend(); ++it) {
       if (!it->removed) {  // an added pair: it is the last slot
         manifolds_.pop_back();
         keys_.pop_back();
-      } else if (it->slot == manifolds_.size()) {  // the last slot was removed
-        manifolds_.push_back(it->memory.manifold());
-        keys_.push_back(manifolds_.back().key());
+        continue;
+      }
+      const contact::ContactManifold m = (removed++)->manifold();
+      if (it->slot == manifolds_.size()) {  // the last slot was removed
+        manifolds_.push_back(m);
+        keys_.push_back(m.key());
       } else {  // the last slot had moved into the removed one
         manifolds_.push_back(manifolds_[it->slot]);
         keys_.push_back(keys_[it->slot]);
-        manifolds_[it->slot] = it->memory.manifold();
-        keys_[it->slot] = manifolds_[it->slot].key();
+        manifolds_[it->slot] = m;
+        keys_[it->slot] = m.key();
       }
     }
     for (auto it = record_.boxes.rbegin(); it != record_.boxes.rend(); ++it) {
@@ -271,7 +279,7 @@ class RigidWorld {
       }
     }
     // The solver's passes visit only the active manifolds (a nested stack has hundreds of pairs,
-    // few of them touching and moving), in list order.
+    // few of them touching and moving), in the order of their pair keys.
     active_.clear();
     if (active_.capacity() < manifolds_.size()) active_.reserve(manifolds_.capacity());
     for (std::size_t i = 0; i < manifolds_.size(); ++i) {
@@ -280,7 +288,6 @@ class RigidWorld {
       record_manifold(i);  // its impulses and friction drift change below
       active_.push_back(&m);
     }
-    // The solver visits them in key order (the list's slots are in order of creation).
     std::sort(active_.begin(), active_.end(), [](const contact::ContactManifold* a, const contact::ContactManifold* b) { return a->key() < b->key(); });
     contact::prepare_contacts(active_, states_, solver_bodies_);
     integrate_velocities(dt);
@@ -380,6 +387,7 @@ class RigidWorld {
     }
     return e;
   }
+  /// One manifold per pair of overlapping fat boxes, in no particular order (update_broadphase).
   const std::vector<contact::ContactManifold>& manifolds() const { return manifolds_; }
   const std::vector<RigidGeom>& geoms() const { return geoms_; }
   /// Number of contact points with separation <= 0 (touching) this step.
@@ -500,8 +508,12 @@ class RigidWorld {
     auto* world = static_cast<RigidWorld*>(data);
     auto a = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(o1->getUserData()) - 1);
     auto b = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(o2->getUserData()) - 1);
-    const BodyId ba = world->geoms_[a].body, bb = world->geoms_[b].body;
-    if (ba == bb || (world->models_[ba].is_static && world->models_[bb].is_static)) return false;
+    const auto& ga = world->geoms_[a];
+    const auto& gb = world->geoms_[b];
+    if (ga.body == gb.body || (world->models_[ga.body].is_static && world->models_[gb.body].is_static)) return false;
+    // FCL keeps a leaf's box when a smaller one is set (after a teleport, undo or restore): the
+    // pair is kept only if our own boxes overlap.
+    if (!((ga.fat_lo.array() <= gb.fat_hi.array()).all() && (gb.fat_lo.array() <= ga.fat_hi.array()).all())) return false;
     if (a > b) std::swap(a, b);
     world->pairs_.push_back((std::uint64_t(a) << 32) | b);
     return false;
@@ -535,7 +547,7 @@ class RigidWorld {
   }
   bool is_moving(BodyId id) const { return !models_[id].is_static && states_[id].awake; }
 
-  /// Keeps manifold i's memory from before this step (once the list was saved whole, that covers it).
+  /// Keeps manifold i's memory from before this step's changes to it (slot i after the list's changes).
   void record_manifold(std::size_t i) {
     if (recording_) record_.manifolds.emplace_back(static_cast<std::uint32_t>(i), contact::ManifoldMemory::of(manifolds_[i]));
   }
@@ -602,7 +614,10 @@ class RigidWorld {
     }
     std::sort(dropped_.begin(), dropped_.end(), std::greater<>());
     for (const auto slot : dropped_) {
-      if (recording_) record_.ops.push_back({slot, true, contact::ManifoldMemory::of(manifolds_[slot])});
+      if (recording_) {
+        record_.ops.push_back({slot, true});
+        record_.removed.push_back(contact::ManifoldMemory::of(manifolds_[slot]));
+      }
       if (slot + 1 < manifolds_.size()) {
         manifolds_[slot] = manifolds_.back();
         keys_[slot] = keys_.back();
@@ -626,7 +641,7 @@ class RigidWorld {
       m.restitution = contact::mix_restitution(models_[ba].restitution, models_[bb].restitution);
       m.rolling_resistance = contact::mix_rolling_resistance(models_[ba].rolling_resistance, models_[bb].rolling_resistance);
       m.fresh = true;
-      if (recording_) record_.ops.push_back({static_cast<std::uint32_t>(manifolds_.size()), false, {}});
+      if (recording_) record_.ops.push_back({static_cast<std::uint32_t>(manifolds_.size()), false});
       manifolds_.push_back(m);
       keys_.push_back(key);
     }
@@ -818,10 +833,10 @@ class RigidWorld {
     std::vector<RigidBodyState> states;
     struct ListOp {  // a change of the manifold list, in order
       std::uint32_t slot;
-      bool removed;                     // false: a manifold was appended at `slot`
-      contact::ManifoldMemory memory;  // the removed manifold
+      bool removed;  // true: the manifold at `slot` was removed (its memory is next in `removed`)
     };
     std::vector<ListOp> ops;
+    std::vector<contact::ManifoldMemory> removed;
     std::vector<std::pair<std::uint32_t, contact::ManifoldMemory>> manifolds;
     struct Box {
       std::uint32_t geom;
