@@ -60,6 +60,11 @@ int main(int argc, char** argv) {
   app.add_option("--retract-speed", expert_config.retract_peak_speed, "expert: peak end-effector speed of the retract after a release, m/s")->check(CLI::PositiveNumber);
   app.add_option("--release-settle-speed", expert_config.release_settle_speed, "expert: a tall object is let go once the arm's tip is slower, m/s")->check(CLI::NonNegativeNumber);
   app.add_option("--lower-speed", expert_config.lower_peak_speed, "expert: peak end-effector speed of the lower line, m/s")->check(CLI::PositiveNumber);
+  app.add_option("--carry-height", expert_config.carry_height, "expert: end-effector above the place pose before lowering, m")->check(CLI::NonNegativeNumber);
+  app.add_option("--slow-lower", expert_config.slow_lower, "expert: a lower line longer than twice this runs at the carry's speed until this far above its end, m (0: all slow)")->check(CLI::NonNegativeNumber);
+  app.add_option("--carry-settle-speed", expert_config.carry_settle_speed, "expert: lower only once the arm's tip is slower at the end of the carry, m/s (0: at once)")->check(CLI::NonNegativeNumber);
+  app.add_option("--lift-height", expert_config.lift_height, "expert: straight up from the grasp first on a via carry, m")->check(CLI::NonNegativeNumber);
+  app.add_option("--min-segment-steps", expert_config.min_segment_steps, "expert: shortest path, control steps")->check(CLI::PositiveNumber);
   app.add_option("--tight-clearance", expert_config.tight_clearance, "expert: a grasp whose open fingers clear the object by less a side is descended to at --lower-speed, m (0: never)")->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
   expert_config.check_arm_clearance = !no_arm_check;

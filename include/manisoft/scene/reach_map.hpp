@@ -62,7 +62,10 @@ inline bool pose_reachable(rod::InverseStatics<double>& statics, const math::Pos
 ///    table top) are reachable, an annulus of radii r_in(h) = inner + inner_slope h and
 ///    r_out(h) = outer + outer_slope h about the base's horizontal position;
 ///  - the two back corners of the table beside the base (x <= corner_x_max, |y| >= corner_y_min),
-///    reached with the gripper turned a quarter turn.
+///    reached with the gripper turned a quarter turn: only with `corners` (off by default). The
+///    arm reaches them curled back beside its base, and moves between them and the annulus are
+///    where the expert fails most (refused or slow lines, lost objects): BENCHMARKS.md, "Expert
+///    episodes".
 /// The coefficients are design parameters read off the measured maps; every sampled pose is still
 /// checked with the inverse statics before a scene is returned.
 struct ReachBand {
@@ -71,6 +74,7 @@ struct ReachBand {
   double outer = 0.60, outer_slope = 0.53;
   double corner_x_max = 0.325, corner_y_min = 0.275;
   double margin = 0.02;
+  bool corners = false;  ///< the back corners are part of the area
   double r_in(double h) const { return inner + inner_slope * h + margin; }
   double r_out(double h) const { return outer + outer_slope * h - margin; }
   bool in_annulus(const Eigen::Vector2d& p, double h) const {
@@ -78,7 +82,7 @@ struct ReachBand {
     return p.x() > center.x() && r >= r_in(h) && r <= r_out(h);
   }
   bool in_corners(const Eigen::Vector2d& p) const { return p.x() <= corner_x_max - margin && std::abs(p.y()) >= corner_y_min + margin; }
-  bool contains(const Eigen::Vector2d& p, double h) const { return in_annulus(p, h) || in_corners(p); }
+  bool contains(const Eigen::Vector2d& p, double h) const { return in_annulus(p, h) || (corners && in_corners(p)); }
 };
 
 struct ReachMapSettings {

@@ -73,7 +73,7 @@ struct SamplerSettings {
   double min_goal_distance = 0.12;  ///< m: an ALN goal / ARR spot this far from the start at least
   double relation_distance = 0.15;  ///< m between an ARR object and its reference
   double fit_clearance = 0.004;     ///< m: a COLL object is this much narrower than the opening
-  double stk_spread = 0.3;          ///< m: STK items lie within this distance of the bottom one (a set of dishes)
+  double stk_spread = 0.2;          ///< m: STK items lie within this distance of the bottom one (a set of dishes; at 0.3 a stack of three often outlasts the horizon)
   geometry::RelationTolerances relations;  ///< ARR: the success predicate's margins
   double relation_margin = 0.02;    ///< m: the ARR spot holds with margins this much tighter, the start fails with them this much wider
   int min_obstacles = 3, max_obstacles = 10;

@@ -921,7 +921,9 @@ class Expert {
         if (lower_fast_ && !supported(state_of(plan_.object))) {
           if (done && error < config_.start_error) {
             lower_fast_ = false;
-            start_path(lower_goal(), true, config_.lower_peak_speed);
+            // refused: the object is already slow_lower above its place (into a container:
+            // below the rim), so it is let go from here once settled
+            start_path(lower_goal(), false, config_.lower_peak_speed);
           }
           break;
         }
