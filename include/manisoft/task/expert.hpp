@@ -23,8 +23,11 @@
 // the rod keeps arm_clearance from the bounding box of every obstacle and every object but the
 // moved one (arm_clear); along the carry lines the held object's and the open gripper's boxes
 // keep held_clearance from the other objects' and obstacles' boxes, except those they cannot
-// avoid at the grasp or the place (held_clear). No detour around an obstacle is planned: a move
-// with no clear candidate is given up.
+// avoid at the grasp or the place (held_clear). Each candidate grasp comes with seven leg
+// variants: the approach and the carry each direct or "via" (below), and the via ones again with
+// their via points raised by via_raise (tried after the others of that grasp: over what the lower
+// lines would sweep the arm through). No detour around an obstacle is planned: a move with no
+// clear candidate is given up.
 // Waypoints of a move (the end-effector frame; straight lines with quintic timing, or a cruise
 // at constant speed over path_cruise of the line: ModelExecutor::track_line): approach (along
 // the annotation's approach direction, approach_distance from the grasp; "via": first to above
@@ -80,6 +83,7 @@ namespace manisoft::task {
 struct ExpertConfig {
   double carry_height = 0.05;       ///< m: end-effector above the place pose before lowering
   double lift_height = 0.06;        ///< m: straight up from the grasp first (a "via" carry)
+  double via_raise = 0.1;           ///< m: the high variants of a grasp (tried after its others) raise their via points this much
   double place_clearance = 0.008;   ///< m: the object's bottom above its support when released
   double retract_height = 0.06;     ///< m: up after every release (at least)
   double finger_clearance = 0.02;   ///< m: and until the fingertips are this far above the released object's top
@@ -215,6 +219,7 @@ class Expert {
     double width = 0;    ///< m, the object's width between the fingers (the grasp annotation's)
     double sink = 0;     ///< m the object is lowered into a container below its rim (COLL)
     bool via_approach = false, via_carry = false;
+    double raise = 0;  ///< m: the via points this much higher (the high variants)
     Pose start;  ///< the end-effector pose the approach leg starts from
     Leg approach_leg, carry_leg;
   };
@@ -264,7 +269,7 @@ class Expert {
   bool set_approach_leg(Plan& p, const Pose& approach, const Pose& from) const {
     p.start = from;
     Pose above = approach;
-    above.translation.z() = std::max(approach.translation.z(), from.translation.z());
+    above.translation.z() = std::max(approach.translation.z(), from.translation.z()) + p.raise;
     const bool tall = p.via_approach && is_tall(p.object);
     if (tall)
       above.translation.z() = std::max(above.translation.z(), approach.translation.z() + top_of(p.object) + config_.approach_tip_clearance - fingertips(approach).z());
@@ -341,7 +346,7 @@ class Expert {
     Pose prev = p.grasp;
     if (p.via_carry) {
       Pose lift = p.grasp;
-      lift.translation.z() += std::max(config_.lift_height, corridor_top(p) + 2 * config_.held_clearance - state_of(p.object).pose.translation.z());
+      lift.translation.z() += std::max(config_.lift_height, corridor_top(p) + 2 * config_.held_clearance - state_of(p.object).pose.translation.z()) + p.raise;
       above.translation.z() = std::max(above.translation.z(), lift.translation.z());
       append_leg(p.carry_leg, prev, lift);
       prev = lift;
@@ -502,7 +507,8 @@ class Expert {
         for (int flip = 0; flip < 2; ++flip) {
           Pose half;
           half.rotation = Eigen::AngleAxisd(flip * std::numbers::pi, Vec3::UnitZ()).toRotationMatrix();
-          for (int variant = 0; variant < 4; ++variant) {
+          for (int variant = 0; variant < 8; ++variant) {
+            if (variant == 4) continue;  // raised with no via point: the same as variant 0
             Plan p;
             p.object = object;
             p.object_target = target;
@@ -512,6 +518,7 @@ class Expert {
             sink_into_container(p);
             p.via_approach = variant & 1;
             p.via_carry = variant & 2;
+            p.raise = variant & 4 ? config_.via_raise : 0.0;
             const bool clear = set_approach_leg(p, now * about_axis * approach_pose(g) * half, from);
             set_carry_leg(p);
             // least turning first, then the fewest lines
