@@ -314,6 +314,12 @@ TEST_CASE("the reach band: points inside are reachable tool-down by the inverse 
                  pose_reachable(statics, tool_down_pose({p.x(), p.y(), top + h}, 1.5707963267948966), top, 0.05);
   }
   REQUIRE(corner_ok >= corner - 2);
+  // reachable, but the samplers' area leaves the corners out unless asked (ReachBand::corners)
+  const Eigen::Vector2d back_corner(0.15, 0.40);
+  REQUIRE_FALSE(band.contains(back_corner, 0.1));
+  ReachBand with_corners;
+  with_corners.corners = true;
+  REQUIRE(with_corners.contains(back_corner, 0.1));
   INFO("inside " << inside_ok << " / " << inside << ", outside " << outside_ok << " / " << outside);
   REQUIRE(inside >= 40);
   REQUIRE(inside_ok >= inside - 2);  // the band is the measured region, shrunk by its margin

@@ -928,8 +928,8 @@ class Expert {
         if (lower_fast_ && !supported(state_of(plan_.object))) {
           if (done && error < config_.start_error) {
             lower_fast_ = false;
-            // refused: the object is already slow_lower above its place (into a container:
-            // below the rim), so it is let go from here once settled
+            // refused: the object is slow_lower above its release height already (into a
+            // container: mostly below the rim), so it is let go from here once settled
             start_path(lower_goal(), false, config_.lower_peak_speed);
           }
           break;
