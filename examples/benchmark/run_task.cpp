@@ -65,7 +65,10 @@ int main(int argc, char** argv) {
   app.add_option("--carry-settle-speed", expert_config.carry_settle_speed, "expert: lower only once the arm's tip is slower at the end of the carry, m/s (0: at once)")->check(CLI::NonNegativeNumber);
   app.add_option("--lift-height", expert_config.lift_height, "expert: straight up from the grasp first on a via carry, m")->check(CLI::NonNegativeNumber);
   app.add_option("--min-segment-steps", expert_config.min_segment_steps, "expert: shortest path, control steps")->check(CLI::PositiveNumber);
+  app.add_option("--max-retries", expert_config.max_retries, "expert: re-tries of a move whose grasp failed, each with another grasp")->check(CLI::NonNegativeNumber);
+  app.add_option("--grasp-error", expert_config.grasp_error, "expert: a descent that ends farther from its grasp pose backs off and re-tries, m")->check(CLI::PositiveNumber);
   app.add_option("--via-raise", expert_config.via_raise, "expert: the high variants of a grasp raise their via points this much, m")->check(CLI::NonNegativeNumber);
+  app.add_flag("!--estimate-in-contact", expert_config.freeze_estimate_in_contact, "expert: keep the executor's stiffness estimate running while the tool may touch things (descend, close, lower, open)");
   app.add_option("--tight-clearance", expert_config.tight_clearance, "expert: a grasp whose open fingers clear the object by less a side is descended to at --lower-speed, m (0: never)")->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
   expert_config.check_arm_clearance = !no_arm_check;

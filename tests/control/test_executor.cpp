@@ -305,6 +305,38 @@ TEST_CASE("the model executor estimates a stiffness error and reaches the target
   CHECK(executor.statics().stiffness_scale() == 1.0);
 }
 
+TEST_CASE("a frozen stiffness estimate keeps its value and resumes when released", "[executor][reach]") {
+  manisoft::env::ReachEnvConfig config;
+  config.model_error = 0.1;  // the simulated arm is 10% stiffer than the model
+  manisoft::env::ReachEnv<manisoft::rod::damping::AnalyticalLinear> env(config, manisoft::rod::damping::AnalyticalLinear<double>(0.1));
+  control::ModelExecutor<double> executor(env.nominal_model(), env.config().limits);
+  // freeze at the first update, release 300 control steps later
+  int frozen_at = -1;
+  double frozen_value = 0;
+  bool held = true;
+  const auto record = manisoft::env::rollout(env, executor, 4, [&](const auto& step) {
+    const double s = executor.stiffness_estimate();
+    if (frozen_at < 0 && s != 1.0) {
+      frozen_at = step.step;
+      frozen_value = s;
+      executor.freeze_estimate(true);
+    } else if (frozen_at >= 0 && step.step < frozen_at + 300) {
+      held = held && s == frozen_value;
+    } else if (frozen_at >= 0 && step.step == frozen_at + 300) {
+      CHECK(executor.estimate_frozen());
+      executor.freeze_estimate(false);
+    }
+  });
+  REQUIRE(frozen_at >= 0);
+  CAPTURE(frozen_at, frozen_value, executor.stiffness_estimate(), record.steps);
+  REQUIRE(record.steps > frozen_at + 400);
+  CHECK(held);
+  CHECK(std::abs(frozen_value - 1.0) < 0.05);  // one update of at most 20%, far from the true 1.1
+  CHECK(std::abs(executor.stiffness_estimate() - 1.1) < std::abs(frozen_value - 1.1) - 0.02);  // it moved on towards 1.1
+  executor.reset();
+  CHECK_FALSE(executor.estimate_frozen());
+}
+
 TEST_CASE("MLP reproduces hand-computed outputs", "[executor][mlp]") {
   // 2 inputs -> 2 relu -> 1 tanh -> 2 linear
   const std::string path = write_file("mlp_ok.txt",

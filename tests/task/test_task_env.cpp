@@ -349,4 +349,42 @@ TEST_CASE("the carry lifts the held object and the gripper over the container's 
   CHECK(travel < 0.005);
 }
 
+TEST_CASE("a descent that ends short of its grasp backs off and re-tries with another grasp", "[tasks][expert]") {
+  // COLL clean 3 (a cup and a basket) with grasp_error so small that every descent counts as
+  // blocked: the first backs off along its approach with the gripper open and the move is planned
+  // again without that grasp (the cup's next yaw); the second, with no re-try left, closes.
+  const SceneSpec s = sample(Task::coll, 3);
+  const std::size_t cup = static_cast<std::size_t>(s.goal.object);
+  TaskEnv& e = env();
+  manisoft::task::ExpertConfig config;
+  config.grasp_error = 1e-5;
+  config.max_retries = 1;
+  Expert expert(e, config);
+  std::vector<manisoft::task::ExpertPhase> phases;
+  std::vector<Eigen::Matrix3d> descent_ends;  // the cup's frame in the gripper's as each descent ends
+  bool held_while_backing_off = false;
+  auto previous = manisoft::task::ExpertPhase::idle;
+  run_expert(e, expert, s, 100000, [&](manisoft::task::ExpertPhase phase) {
+    if (phase != previous) phases.push_back(phase);
+    if (previous == manisoft::task::ExpertPhase::descend && phase != previous) {
+      const auto& r = e.world().rigid();
+      const Eigen::Matrix3d gripper = r.orientation(e.world().gripper_body()).toRotationMatrix();
+      descent_ends.push_back(gripper.transpose() * e.snapshot().objects[cup].pose.rotation);
+    }
+    if (phase == manisoft::task::ExpertPhase::retract && expert.move() == 0 && e.world().gripper().held()) held_while_backing_off = true;
+    previous = phase;
+  });
+  using P = manisoft::task::ExpertPhase;
+  const std::vector<P> expected = {P::approach, P::descend, P::retract, P::approach, P::descend, P::close, P::carry};
+  REQUIRE(phases.size() >= expected.size());
+  CHECK(std::equal(expected.begin(), expected.end(), phases.begin()));
+  CHECK_FALSE(held_while_backing_off);
+  REQUIRE(descent_ends.size() >= 2);
+  // the cup is round: the re-try's grasp is the same annotation turned about its axis (at least
+  // the 0.2 rad the exclusion compares)
+  CHECK(Eigen::AngleAxisd(descent_ends[0] * descent_ends[1].transpose()).angle() > 0.2);
+  CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure));
+  CHECK(e.info().success);
+}
+
 }  // namespace test_task_env

@@ -240,7 +240,7 @@ class ModelExecutor {
     payload_offset_.setZero();
     payload_step_ = payload_steps_ = 0;
     node_mass_[statics_.n_elements()] = tip_node_mass_;
-    converged_ = saturated_ = false;
+    converged_ = saturated_ = estimate_frozen_ = false;
     statics_.set_model_estimates(Scalar(1), statics_.model().payload_mass);
     statics_.set_coefficients(rod::InverseStatics<Scalar>::Coefficients::Zero());
     adapt_count_ = 0;
@@ -262,7 +262,7 @@ class ModelExecutor {
                           max_speed <= settings_.estimate_speed_gate;
     saturated_ = feedforward_plus_feedback(o, twist_rate, action);
     // A saturated actuator does not apply the torque the estimate assumes: no update then.
-    if (adapting && !saturated_) accumulate_estimate(o);
+    if (adapting && !saturated_ && !estimate_frozen_) accumulate_estimate(o);
     ++steps_;
     converged_ = steps_ >= ramp_steps_ && max_speed <= settings_.converged_speed &&
                  (o.end_effector.translation - target_.translation).norm() <= settings_.converged_position &&
@@ -396,6 +396,18 @@ class ModelExecutor {
     if (payload_steps_ == 0) apply_payload(mass);
   }
   Scalar payload() const { return payload_; }
+
+  /// Freezes (true) or resumes (false) the stiffness estimate, keeping its current value. The
+  /// estimate assumes the arm carries nothing but its model and payload: a planner that knows its
+  /// tool presses on something (fingers around an object, a held object set on its support)
+  /// freezes it meanwhile, or that contact's deflection is read as a stiffness error and the
+  /// feed-forward changes under the contact (a twist chatter of 10-15 rad/s at the tip was seen).
+  /// A partial averaging period is dropped either way.
+  void freeze_estimate(bool frozen) {
+    if (frozen != estimate_frozen_) adapt_count_ = 0;
+    estimate_frozen_ = frozen;
+  }
+  bool estimate_frozen() const { return estimate_frozen_; }
 
   /// Converged: the current path's (or ramp's) end reached, the end-effector within
   /// converged_position / converged_rotation of the target and every observed node slower than
@@ -902,7 +914,7 @@ class ModelExecutor {
   Vector3 payload_offset_ = Vector3::Zero();
   int payload_step_ = 0, payload_steps_ = 0;
   Scalar tip_node_mass_ = 0;
-  bool converged_ = false, saturated_ = false;
+  bool converged_ = false, saturated_ = false, estimate_frozen_ = false;
   Eigen::Matrix<Scalar, 6, 1> error_sum_ = Eigen::Matrix<Scalar, 6, 1>::Zero();
   int error_count_ = 0;
   Matrix3 previous_rotation_ = Matrix3::Identity();

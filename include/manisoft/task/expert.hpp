@@ -99,7 +99,7 @@ struct ExpertConfig {
   double release_settle_speed = 0.05;  ///< m/s: once the support carries a tall object, stop and open only when the arm's tip is slower (0: open at once)
   double tall_ratio = 1.2;          ///< an object is tall (release_settle_speed) above this height / width
   double release_lift = 0.0;        ///< m: the stop above where the arm is (release_settle_speed)
-  double contact_depth = 0.004;     ///< m: a tall object is lowered until its support carries it: its lower line ends this far below its support
+  double contact_depth = 0.001;     ///< m: a tall object is lowered until its support carries it: its lower line ends this far below its support (deeper presses it on, and it rocks on its base after the release)
   double retract_peak_speed = 0.9;  ///< m/s: peak end-effector speed of the retract after a release
   double lower_peak_speed = 0.3;    ///< m/s: peak end-effector speed of the lower line
   double slow_lower = 0.03;         ///< m: a lower line longer than twice this runs at the carry's speed until this far above its end (0: all slow)
@@ -113,9 +113,11 @@ struct ExpertConfig {
   double held_clearance = 0.01;     ///< m: the held object's and the open gripper's boxes clear of theirs along the carry
   bool check_arm_clearance = true;  ///< false: lines are not checked against objects and obstacles (for measuring the check)
   double arc_inset = 0.03;          ///< m: a straight leg this much nearer the base than its farther end goes round an arc point
-  int max_retries = 1;              ///< re-tries of a missed grasp
+  int max_retries = 1;              ///< re-tries of a move whose grasp failed (missed, blocked or not carriable), each with another grasp
+  double grasp_error = 0.02;        ///< m: a descent that ends farther than this from its grasp pose (a finger on the object) backs off and re-tries
   double approach_distance = 0.06;  ///< m: the approach pose this far from the grasp, along the annotation's approach direction
   bool ramp_fallback = true;        ///< a refused line may be replaced by a shape ramp
+  bool freeze_estimate_in_contact = true;  ///< the executor's stiffness estimate is frozen while the tool may touch things (descend, close, lower, open)
 };
 
 /// What the expert is doing.
@@ -161,6 +163,7 @@ class Expert {
                          0.5 * (gp.palm_thickness + gp.finger_length));
     gripper_center_ = Vec3(0, 0, gripper_half_.z());
     events_.reserve(64);
+    excluded_.reserve(8);
   }
 
   /// Starts the episode of the env's current scene (call after env.reset()).
@@ -169,6 +172,7 @@ class Expert {
     target_ = env_->home_pose();
     move_ = 0;
     retries_ = 0;
+    excluded_.clear();
     s_ = 0;
     waited_ = 0;
     touched_ = false;
@@ -514,6 +518,7 @@ class Expert {
             p.object_target = target;
             p.width = g.width;
             p.grasp = now * about_axis * g.grasp * half;
+            if (excluded(now, p.grasp)) continue;
             p.place = target * now.inverse() * p.grasp;
             sink_into_container(p);
             p.via_approach = variant & 1;
@@ -727,6 +732,8 @@ class Expert {
 
   void enter(ExpertPhase p) {
     phase_ = p;
+    executor_.freeze_estimate(config_.freeze_estimate_in_contact && (p == ExpertPhase::descend || p == ExpertPhase::close ||
+                                                                     p == ExpertPhase::lower || p == ExpertPhase::open));
     if (events_.size() < events_.capacity()) {
       ExpertEvent e;
       e.step = steps_;
@@ -736,6 +743,26 @@ class Expert {
       events_.push_back(e);
     }
   }
+  /// Backs off along the descent to the approach pose (gripper open) and plans the move again
+  /// without this grasp (max_retries); false, nothing changed, when no re-try is left.
+  bool retry_with_another_grasp() {
+    if (retries_ >= config_.max_retries || plan_.object < 0) return false;
+    ++retries_;
+    s_ = 0;
+    excluded_.push_back(state_of(plan_.object).pose.inverse() * plan_.grasp);
+    enter(ExpertPhase::retract);
+    if (!start_path(plan_.approach_leg.pose[static_cast<std::size_t>(plan_.approach_leg.count - 1)], false)) begin_move();
+    return true;
+  }
+  /// Whether grasp g (end-effector pose, the object at `object`) is one a re-try left out.
+  bool excluded(const Pose& object, const Pose& g) const {
+    for (const Pose& e : excluded_) {
+      const Pose d = object.inverse() * g;
+      if ((d.translation - e.translation).norm() < 0.01 && Eigen::AngleAxisd(d.rotation * e.rotation.transpose()).angle() < 0.2) return true;
+    }
+    return false;
+  }
+
   void give_up(const char* why) {
     failure_ = why;
     enter(ExpertPhase::failed);
@@ -854,6 +881,9 @@ class Expert {
       case ExpertPhase::descend:
         if (done && (settled || ++waited_ > config_.max_settle_steps)) {
           waited_ = 0;
+          // blocked short of the grasp (a finger on the object): the hand would close around
+          // the object askew, and its carry is then mostly beyond the actuation limits
+          if (error > config_.grasp_error && retry_with_another_grasp()) break;
           s_ = 1;
           enter(ExpertPhase::close);
         }
@@ -868,6 +898,7 @@ class Expert {
           }
           break;
         }
+        bool carriable = false;
         // Where the object sits in the hand: the payload hint and the place correction.
         const Pose ee{f.rotation, f.position};
         const Pose object = state_of(plan_.object).pose;
@@ -893,8 +924,18 @@ class Expert {
           const char* why = "";
           if (check_carry_leg(checked, ee, object, support_of(move_), why) && check_line(checked.place, why)) {
             plan_ = checked;
+            carriable = true;
             break;
           }
+        }
+        // neither carry passes from where the object sits in the hand: put it back (it still
+        // stands where it was grasped) and re-try with another grasp
+        if (!carriable) {
+          s_ = 0;
+          executor_.set_payload(0.0);
+          if (retry_with_another_grasp()) break;
+          s_ = 1;
+          executor_.set_payload(a.mass, ee.rotation.transpose() * (object.act(a.center_of_mass) - ee.translation));
         }
         leg_ = 0;
         enter(ExpertPhase::carry);
@@ -963,6 +1004,7 @@ class Expert {
         // around it keep pushing it as the arm sways, and it never comes to rest).
         ++move_;
         retries_ = 0;
+        excluded_.clear();
         enter(ExpertPhase::retract);
         // a refused retract is not a failure: the next move plans from here, or the arm holds
         if (!start_path(retract_pose(), false, config_.retract_peak_speed)) {
@@ -992,6 +1034,7 @@ class Expert {
   Plan plan_;
   ExpertPhase phase_ = ExpertPhase::idle;
   int move_ = 0, moves_ = 0, retries_ = 0, s_ = 0, waited_ = 0, leg_ = 0;
+  std::vector<Pose> excluded_;  ///< grasps (in the object's frame) re-tries of this move leave out
   long steps_ = 0;
   std::vector<ExpertEvent> events_;
   const char* failure_ = nullptr;
