@@ -49,7 +49,8 @@
 //             observed node deviations (and the tip rotation deviation) averaged over the period
 //             are regressed on the shape change of a relative curvature scaling, beta, and
 //             s_hat <- s_hat (1 - g beta). With the right s_hat the desired shape is again an exact
-//             equilibrium of the arm.
+//             equilibrium of the arm. freeze_estimate() holds it while the tool presses on
+//             something the model does not include.
 //   outer loop every `outer_period` control steps while quasi-static: with the pose error
 //             averaged over the period, e_p = p* - p, e_R = log(R* R^T) (lab), the shape target
 //             moves by  p_s <- p_s + K e_p,  R_s <- Exp(K e_R) R_s,  and the inverse statics is

@@ -48,11 +48,16 @@
 // fingertips clear the object's top (after the last move too). A
 // leg whose straight line would pass towards the inner edge of the arm's reach (arc_inset nearer
 // its base than its farther end) goes round an arc point about the base instead. A missed grasp
-// re-opens and retries the move from its approach (max_retries).
+// re-opens and retries the move from its approach (max_retries); so does, backing off along its
+// approach with the gripper open, a descent that ends grasp_error short of its grasp or a grasp
+// whose carry no longer passes from where the object sits in the hand, the move then planned
+// without that grasp. The executor's stiffness estimate is frozen while the tool may touch
+// something (descend, close, lower, open: ModelExecutor::freeze_estimate).
 // Refused lines: the candidates are first checked with straight lines only; when none passes,
 // again with each refused approach or carry line replaced by the executor's shape ramp to the
-// pose's cold inverse statics solution (ModelExecutor::set_target; ramp_fallback), when that is
-// within the limits and clear of the table (the ramp's intermediate shapes are not checked). A
+// pose's cold inverse statics solution (ModelExecutor::set_target; ramp_fallback; not on a
+// re-try), when that is within the limits and clear of the table (the ramp's intermediate shapes
+// are not checked). A
 // line the executor refuses while running (it starts from where the arm's shape target is, not
 // the planned pose) also falls back to a ramp.
 // Deterministic; allocation only when a move is planned, its carry re-checked at the grasp or a
@@ -540,7 +545,9 @@ class Expert {
     plan_object_ = object;
     for (int pass = 0; pass < 2; ++pass) {
     repair_ = pass == 1;
-    if (repair_ && !config_.ramp_fallback) break;
+    // (a re-try, whose first grasp failed, searches straight lines only: the repair pass checks
+    // every candidate again, about 0.5 s when none passes)
+    if (repair_ && (!config_.ramp_fallback || retries_ > 0)) break;
     for (auto c : candidates) {
       planner_ = executor_;
       planner_.complete_path();
@@ -930,12 +937,10 @@ class Expert {
         }
         // neither carry passes from where the object sits in the hand: put it back (it still
         // stands where it was grasped) and re-try with another grasp
-        if (!carriable) {
-          s_ = 0;
+        if (!carriable && retries_ < config_.max_retries) {
           executor_.set_payload(0.0);
-          if (retry_with_another_grasp()) break;
-          s_ = 1;
-          executor_.set_payload(a.mass, ee.rotation.transpose() * (object.act(a.center_of_mass) - ee.translation));
+          retry_with_another_grasp();
+          break;
         }
         leg_ = 0;
         enter(ExpertPhase::carry);
