@@ -70,6 +70,9 @@ int main(int argc, char** argv) {
   app.add_option("--via-raise", expert_config.via_raise, "expert: the high variants of a grasp raise their via points this much, m")->check(CLI::NonNegativeNumber);
   app.add_flag("!--estimate-in-contact", expert_config.freeze_estimate_in_contact, "expert: keep the executor's stiffness estimate running while the tool may touch things (descend, close, lower, open)");
   app.add_option("--tight-clearance", expert_config.tight_clearance, "expert: a grasp whose open fingers clear the object by less a side is descended to at --lower-speed, m (0: never)")->check(CLI::NonNegativeNumber);
+  task::TaskEnvConfig env_config;
+  app.add_option("--executor-damping", env_config.executor.damping_gain, "executor: node velocity feedback kd, 1/s")->check(CLI::NonNegativeNumber);
+  app.add_option("--executor-stiffness", env_config.executor.position_gain, "executor: node position feedback kp, 1/s^2")->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
   expert_config.check_arm_clearance = !no_arm_check;
   try {
@@ -88,7 +91,7 @@ int main(int argc, char** argv) {
       spec = sampler.sample(q);
     }
     if (!save_scene.empty()) scene::save_scene(save_scene, spec);
-    task::TaskEnv env(sampler.library());
+    task::TaskEnv env(sampler.library(), env_config);
     task::Expert expert(env, expert_config);
     const std::clock_t c1 = std::clock();
     env.reset(spec);

@@ -62,7 +62,18 @@ struct TaskEnvConfig {
   /// rest in the predicates' sense too: it was slower than half their limits all that time.
   double time_to_sleep = 0.1;
   Tolerances tolerances{};
-  control::ModelExecutorSettings<double> executor{};
+  /// The executor the expert (and any model-based policy) uses in the task world: the reach
+  /// environment's defaults with twice its node velocity feedback (kd 70 /s against 35): with a
+  /// held object, an object under the fingers and fast lines the arm sways after every path for
+  /// about 100 control steps at kd 35, which costs the expert's settling waits their time and
+  /// sets objects down swinging (BENCHMARKS.md, "Expert episodes").
+  control::ModelExecutorSettings<double> executor = task_executor_settings();
+
+  static control::ModelExecutorSettings<double> task_executor_settings() {
+    control::ModelExecutorSettings<double> s;
+    s.damping_gain = 70;
+    return s;
+  }
 };
 
 /// What one control step reports.
