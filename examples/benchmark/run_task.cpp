@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   app.add_option("--path-speed", expert_config.path_peak_speed, "expert: peak end-effector speed of a path with the gripper empty, m/s")->check(CLI::PositiveNumber);
   app.add_option("--node-speed", expert_config.max_node_speed, "expert: planned peak speed of any rod node with the gripper empty, m/s")->check(CLI::PositiveNumber);
   app.add_option("--carry-speed", expert_config.carry_peak_speed, "expert: peak end-effector speed while holding, m/s")->check(CLI::PositiveNumber);
+  app.add_option("--carry-grip-share", expert_config.carry_grip_share, "expert: a held line accelerates the object at most this share of max_hold_force / mass (0: not bounded)")->check(CLI::NonNegativeNumber);
   app.add_option("--carry-node-speed", expert_config.carry_node_speed, "expert: planned peak node speed while holding, m/s")->check(CLI::PositiveNumber);
   app.add_option("--path-cruise", expert_config.path_cruise, "expert: fraction of a path at constant speed (0: quintic timing)")->check(CLI::Range(0.0, 0.95));
   app.add_option("--settle-speed", expert_config.settle_speed, "expert: close / open once the arm's tip is slower, m/s")->check(CLI::PositiveNumber);

@@ -96,6 +96,7 @@ struct ExpertConfig {
   double max_node_speed = 1.5;      ///< m/s, planned peak speed of any rod node (gripper empty)
   double carry_peak_speed = 1.2;    ///< m/s, the same while an object is held
   double carry_node_speed = 1.2;    ///< m/s
+  double carry_grip_share = 0.45;   ///< a held line's planned peak acceleration at most this share of what the grip holds (max_hold_force / mass; 0: not bounded): a short lift at the carry's speed accelerated a tall bottle at about 10 g, past the grip's 40 N
   double path_cruise = 0.7;         ///< fraction of a path at constant speed (0: quintic timing; ModelExecutor::track_line)
   int min_segment_steps = 60;       ///< shortest path, control steps
   double settle_speed = 0.15;       ///< m/s: close / open only when the arm's tip is slower
@@ -577,7 +578,7 @@ class Expert {
   bool check_line(const Pose& to, const char*& why) {
     planner_backup_ = planner_;
     const Pose from = planner_.statics().desired_tip_pose();
-    const auto report = planner_.track_line(to, line_steps((to.translation - from.translation).norm(), check_held_), node_step(check_held_), config_.path_cruise);
+    const auto report = planner_.track_line(to, line_steps((to.translation - from.translation).norm(), check_held_, 0, plan_object_), node_step(check_held_), config_.path_cruise);
     bool clear = report.accepted && held_line_clear(from, to);
     for (int k = 1; k <= line_samples && report.accepted && clear; ++k) {
       planner_.predicted_shape(long(report.steps) * k / line_samples, shape_);
@@ -779,7 +780,7 @@ class Expert {
   bool start_path(const Pose& goal, bool required = true, double peak_speed = 0) {
     const double distance = (goal.translation - executor_.statics().desired_tip_pose().translation).norm();
     const bool loaded = s_ == 1;
-    const int steps = line_steps(distance, loaded, peak_speed);
+    const int steps = line_steps(distance, loaded, peak_speed, plan_.object);
     const auto report = executor_.track_line(goal, steps, node_step(loaded), config_.path_cruise);
     if (!report.accepted) {
       // the executor's shape ramp to the goal's cold solution instead, when it has one
@@ -792,12 +793,22 @@ class Expert {
   }
 
   /// Control steps of a line `distance` long at its peak end-effector speed (`peak_speed`, or
-  /// the configured one with the gripper empty or holding), before the node speed bound.
-  int line_steps(double distance, bool loaded, double peak_speed = 0) const {
+  /// the configured one with the gripper empty or holding), before the node speed bound; holding
+  /// object `held`, also within carry_grip_share of what the grip holds.
+  int line_steps(double distance, bool loaded, double peak_speed, int held) const {
     const double peak = peak_speed > 0 ? peak_speed : loaded ? config_.carry_peak_speed : config_.path_peak_speed;
     // peak speed / mean speed of the timing
     const double peak_ratio = config_.path_cruise > 0 ? 2 / (1 + config_.path_cruise) : 1.875;
-    return std::max(config_.min_segment_steps, static_cast<int>(std::ceil(peak_ratio * distance / peak / env_->control_dt())));
+    double seconds = peak_ratio * distance / peak;
+    if (loaded && config_.carry_grip_share > 0 && held >= 0) {
+      // peak acceleration of the timing: 6 d / (T^2 (1 - c^2)) with a cruise c (smoothstep speed
+      // ramps over (1 - c) T / 2 at each end), 5.77 d / T^2 quintic
+      const double c = config_.path_cruise;
+      const double shape = c > 0 ? 6 / (1 - c * c) : 5.7735;
+      const double accel = config_.carry_grip_share * env_->gripper_parameters().max_hold_force / asset_of(held).mass;
+      seconds = std::max(seconds, std::sqrt(shape * distance / accel));
+    }
+    return std::max(config_.min_segment_steps, static_cast<int>(std::ceil(seconds / env_->control_dt())));
   }
   /// The node speed bound of a line, m per control step.
   double node_step(bool loaded) const { return (loaded ? config_.carry_node_speed : config_.max_node_speed) * env_->control_dt(); }
