@@ -65,6 +65,28 @@ BodyId add_asset(rigid::RigidWorld& w, const Asset& a, const Pose<double>& at) {
   return w.add_body(d);
 }
 
+/// Extent along the gripper's closing axis (x) of a body's collision geometry that reaches into
+/// the fingers' span (gripper frame z in [z0, z1]), from the geometries' bounding boxes in the
+/// gripper frame: exact for the catalogue's upright cylinders and aligned boxes.
+double collision_width(const rigid::RigidWorld& w, BodyId b, BodyId gripper, double z0, double z1) {
+  const Eigen::Matrix3d rg = w.orientation(gripper).toRotationMatrix();
+  const Vector3d xg = w.position(gripper);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  const auto& m = w.model(b);
+  for (std::uint32_t g = m.first_geom; g < m.first_geom + m.geom_count; ++g) {
+    const auto gp = w.geom_pose(g);
+    manisoft::contact::Pose local;
+    local.rotation = rg.transpose() * gp.rotation;
+    local.translation = rg.transpose() * (gp.translation - xg);
+    Vector3d glo, ghi;
+    w.geoms()[g].shape.bounds(local, glo, ghi);
+    if (ghi.z() <= z0 || glo.z() >= z1) continue;
+    lo = std::min(lo, glo.x());
+    hi = std::max(hi, ghi.x());
+  }
+  return hi - lo;
+}
+
 Pose<double> compose(const Pose<double>& a, const Pose<double>& b) {
   return Pose<double>{a.rotation * b.rotation, a.translation + a.rotation * b.translation};
 }
@@ -165,12 +187,22 @@ TEST_CASE("every grasp annotation closes the gripper on its object on the table"
       CHECK((w.position(object) - x0).norm() < 1e-3);
       CHECK(gripper.finger_width() == Approx(gp.open_width));
       gripper.command(1);
-      for (int i = 0; i < 10; ++i) step_kinematic(w, gripper, Vector3d::Zero());
+      // The fingers close at open_width / stroke_time: they reach the object's collision
+      // geometry (a lathe's is its equal-volume cylinder, narrower than the visual where the
+      // profile bulges) in (open_width - width) / that speed, and stop there on the object.
+      const double width = collision_width(w, object, gripper.body(), gp.palm_thickness, tip_z);
+      const int stroke_steps = int(std::ceil((gp.open_width - width) / gp.open_width * gp.stroke_time / kDt));
+      int steps = 0;
+      do {
+        step_kinematic(w, gripper, Vector3d::Zero());
+      } while (gripper.closing() && ++steps < 2 * stroke_steps + 10);
       REQUIRE(gripper.held());
       CHECK(*gripper.held() == object);
       CHECK(gripper.state() == 1);
-      CHECK(gripper.finger_width() > 0);
-      CHECK(gripper.finger_width() < gp.open_width);
+      CHECK(steps <= stroke_steps + 2);
+      CHECK(gripper.finger_width() == Approx(width).margin(1.2e-3));
+      // The object was not pushed out of place on the way.
+      CHECK((w.position(object) - x0).norm() < 3e-3);
       // Lift 3.5 cm (speed ramped to 0.3 m/s over 0.05 s): the weld carries the object.
       for (int i = 0; i < 700; ++i) step_kinematic(w, gripper, Vector3d(0, 0, 0.3 * std::min(1.0, i / 250.0)));
       REQUIRE(gripper.held());

@@ -1,8 +1,10 @@
 // The parallel gripper's grasp mechanism on a gripper body driven kinematically (velocity set
-// every step, gravity cancelled) above a table: closing on an object between the fingers grasps
-// it and lifts it (sag m g / k), closing on nothing grasps nothing, opening releases (the object
-// falls back onto the table), a held object still collides with the world (a wall stops it, and
-// pushing on makes the grasp slip at the hold-force limit), bad commands are refused.
+// every step, gravity cancelled) above a table: the fingers move at open_width / stroke_time,
+// closing on an object between them grasps it where both touch it and lifts it (sag m g / k), an
+// off-centre object is pushed to the middle, closing on nothing grasps nothing, a closed gripper
+// lands on an object instead of passing around it, opening releases (the object falls back onto
+// the table), a held object still collides with the world (a wall stops it, and pushing on makes
+// the grasp slip at the hold-force limit), bad commands are refused.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -67,10 +69,22 @@ TEST_CASE("closing on an object between the fingers grasps and lifts it", "[worl
   s.run(Vector3d::Zero(), 0.05);
   CHECK(s.gripper.finger_width() == Approx(0.10));
   s.gripper.command(1);
-  s.run(Vector3d::Zero(), 0.05);
+  // The gap closes at 0.10 m / 0.1 s: the fingers reach the 5 cm cube after 0.05 s (250 steps),
+  // within touch_tolerance (0.5 mm) a side, one step of 0.2 mm earlier at most.
+  int steps = 0;
+  while (!s.gripper.held() && steps < 400) {
+    s.step(Vector3d::Zero());
+    ++steps;
+  }
   REQUIRE(s.gripper.held());
   CHECK(*s.gripper.held() == s.cube);
-  CHECK(s.gripper.finger_width() == Approx(2 * s.cube_half).margin(1e-9));
+  CHECK(s.gripper.grasped_now());
+  CHECK(steps >= 244);
+  CHECK(steps <= 250);
+  CHECK(s.gripper.finger_width() >= 2 * s.cube_half);
+  CHECK(s.gripper.finger_width() <= 2 * s.cube_half + 2 * 5e-4 + 1e-12);
+  s.run(Vector3d::Zero(), 0.05);
+  CHECK(s.gripper.finger_width() == Approx(2 * s.cube_half).margin(1e-3));  // stopped on the cube
   const Vector3d offset0 = s.world.center_of_mass(s.cube) - s.world.position(s.gripper_body);
   s.run(Vector3d(0, 0, 0.3), 1.0);      // lift 0.3 m
   s.run(Vector3d(0.5, 0.0, 0.0), 0.4);  // carry sideways at 0.5 m/s
@@ -89,8 +103,12 @@ TEST_CASE("closing on nothing grasps nothing", "[world][gripper]") {
   Scene s(0.3);  // the cube is 30 cm away
   s.run(Vector3d::Zero(), 0.05);
   s.gripper.command(1);
-  s.run(Vector3d::Zero(), 0.05);
+  s.run(Vector3d::Zero(), 0.05);  // half the stroke
+  CHECK(s.gripper.finger_width() == Approx(0.05).margin(1e-9));
+  CHECK(s.gripper.closing());
+  s.run(Vector3d::Zero(), 0.06);
   CHECK_FALSE(s.gripper.held());
+  CHECK_FALSE(s.gripper.closing());
   CHECK(s.gripper.state() == 1);
   CHECK(s.gripper.finger_width() == 0.0);
   const Vector3d cube0 = s.world.center_of_mass(s.cube);
@@ -104,7 +122,7 @@ TEST_CASE("closing on nothing grasps nothing", "[world][gripper]") {
 TEST_CASE("opening releases the object onto the table", "[world][gripper]") {
   Scene s(0.01);  // slightly off-centre between the fingers: still grasped
   s.gripper.command(1);
-  s.run(Vector3d::Zero(), 0.05);
+  s.run(Vector3d::Zero(), 0.1);
   REQUIRE(s.gripper.held());
   s.run(Vector3d(0, 0, 0.2), 0.5);  // lift 10 cm
   const double lifted = s.world.center_of_mass(s.cube).z();
@@ -118,7 +136,10 @@ TEST_CASE("opening releases the object onto the table", "[world][gripper]") {
   s.run(Vector3d::Zero(), 0.02);
   CHECK_FALSE(s.gripper.held());
   CHECK(s.gripper.last_released() == s.cube);
+  CHECK(s.gripper.opening());
   s.run(Vector3d::Zero(), 0.6);  // free fall of 7.5 cm (0.12 s), then rest
+  CHECK_FALSE(s.gripper.opening());
+  CHECK(s.gripper.finger_width() == Approx(0.10).margin(1e-12));
   CAPTURE(lifted, s.world.center_of_mass(s.cube).transpose());
   CHECK(lifted > 0.12);
   CHECK(s.world.center_of_mass(s.cube).z() == Approx(s.cube_half).margin(1e-3));
@@ -137,7 +158,7 @@ TEST_CASE("a grasped object still collides with the world", "[world][gripper]") 
   wall.name = "wall";
   s.world.add_body(wall);
   s.gripper.command(1);
-  s.run(Vector3d::Zero(), 0.05);
+  s.run(Vector3d::Zero(), 0.1);
   REQUIRE(s.gripper.held());
   s.run(Vector3d(0, 0, 0.1), 0.2);  // lift 2 cm
   // Carry the cube into the wall at 0.5 m/s: its face reaches it after 0.175 m (0.35 s); pushing
@@ -160,12 +181,52 @@ TEST_CASE("a grasped object still collides with the world", "[world][gripper]") 
   CHECK_FALSE(s.gripper.held());
 }
 
+TEST_CASE("the closing fingers push an off-centre object to the middle before they grasp it", "[world][gripper]") {
+  Scene s(0.02);  // 2 cm towards the +x finger: its inner face (at 5 cm) is 5 mm from the cube
+  s.gripper.command(1);
+  double first_touch = -1;
+  for (int i = 0; i < 400 && !s.gripper.held(); ++i) {
+    s.step(Vector3d::Zero());
+    if (first_touch < 0 && s.world.center_of_mass(s.cube).x() < 0.02 - 1e-4) first_touch = (i + 1) * kDt;
+  }
+  REQUIRE(s.gripper.held());
+  // The +x finger moves at 0.5 m/s: it reaches the cube after 5 mm (0.01 s) and pushes it; the
+  // grasp comes when the other finger touches, with the cube between them, at the middle.
+  CAPTURE(first_touch, s.world.center_of_mass(s.cube).transpose());
+  CHECK(first_touch == Approx(0.01).margin(0.002));
+  CHECK(std::abs(s.world.center_of_mass(s.cube).x() - s.world.position(s.gripper_body).x()) < 2e-3);
+  CHECK(s.world.center_of_mass(s.cube).z() == Approx(s.cube_half).margin(1e-3));  // slid, not lifted or tipped
+  CHECK(s.gripper.finger_width() == Approx(2 * s.cube_half).margin(2e-3));
+}
+
+TEST_CASE("a closed gripper lands on an object instead of passing around it", "[world][gripper]") {
+  Scene s(0.0);
+  s.run(Vector3d(0, 0, 0.2), 0.5);  // up 10 cm, open: the cube is out of reach
+  s.gripper.command(1);
+  s.run(Vector3d::Zero(), 0.12);
+  REQUIRE(s.gripper.finger_width() == 0.0);
+  REQUIRE_FALSE(s.gripper.held());
+  // Down at 0.2 m/s for 0.7 s (14 cm): open fingers would straddle the cube; closed ones stop on
+  // its top face (z = 5 cm), and the cube stays on the table.
+  const auto& p = s.gripper.parameters();
+  s.run(Vector3d(0, 0, -0.2), 0.7);
+  const double tips = s.world.position(s.gripper_body).z() - (p.palm_thickness + p.finger_length);
+  CAPTURE(tips, s.world.center_of_mass(s.cube).transpose());
+  CHECK(tips > 2 * s.cube_half - 3e-3);
+  CHECK(tips < 2 * s.cube_half + 1e-3);
+  CHECK(s.world.center_of_mass(s.cube).z() == Approx(s.cube_half).margin(2e-3));
+  CHECK_FALSE(s.gripper.held());
+}
+
 TEST_CASE("the gripper refuses bad commands and parameters", "[world][gripper]") {
   manisoft::interaction::ParallelGripper g;
   CHECK_THROWS_WITH(g.command(2), Catch::Matchers::Contains("S = 2"));
   manisoft::interaction::ParallelGripperParameters p;
   p.open_width = 0.2;  // wider than the palm
   CHECK_THROWS_WITH(manisoft::interaction::ParallelGripper(p), Catch::Matchers::Contains("palm_half_x"));
+  p = {};
+  p.stroke_time = 0;
+  CHECK_THROWS_WITH(manisoft::interaction::ParallelGripper(p), Catch::Matchers::Contains("stroke_time = 0"));
   p = {};
   p.mass = -1;
   CHECK_THROWS_WITH(manisoft::interaction::make_parallel_gripper(p), Catch::Matchers::Contains("mass = -1"));

@@ -68,6 +68,7 @@ struct ContactManifold {
   bool rolling{false};              ///< last detection was a rolling contact (ContactSet::rolling)
   // Per step.
   Vec3 normal{Vec3::UnitZ()}, tangent1{Vec3::UnitX()}, tangent2{Vec3::UnitY()};
+  Vec3 surface_velocity{Vec3::Zero()};  ///< B's surface velocity minus A's, beyond their bodies' motion (world)
 
   std::uint64_t key() const { return (std::uint64_t(geom_a) << 32) | geom_b; }
 };

@@ -35,6 +35,9 @@
 // Relax: the same with bias = 0 (rigid), so the velocity left after the step carries no
 // position-correction term. Restitution: after relax, points that approached faster than the
 // threshold get lambda such that v_n = -e v_n,before.
+// Moving surfaces (a gripper's finger moving within its body): every relative velocity above
+// includes the manifold's surface_velocity, so the contact drives the other body at the surface's
+// speed instead of letting the surface sink in and pushing it out by penetration recovery.
 #pragma once
 
 #include "manisoft/contact/contact_manifold.hpp"
@@ -132,7 +135,7 @@ void prepare_contacts(ActiveManifolds manifolds, const BodyStates& states,
       p.rb_x_n = rbn;
       p.ia_ra_x_n = ba.inv_inertia * ran;
       p.ib_rb_x_n = bb.inv_inertia * rbn;
-      p.relative_velocity = n.dot(detail::relative_velocity(ba, bb, p.ra, p.rb));
+      p.relative_velocity = n.dot(detail::relative_velocity(ba, bb, p.ra, p.rb) + m.surface_velocity);
       p.max_normal_impulse = 0;
     }
     auto& f = m.patch;
@@ -223,7 +226,7 @@ inline void solve_contacts(ActiveManifolds manifolds, std::vector<SolverBody>& b
     const double max_friction = m.friction * total_normal;
     // Tangential friction at the centroid (Coulomb disc, anchored when sticking).
     {
-      const Vec3 dv_lin = bb.v - ba.v;
+      const Vec3 dv_lin = bb.v - ba.v + m.surface_velocity;
       const Eigen::Vector2d vt(m.tangent1.dot(dv_lin) + bb.w.dot(f.rb_x_t[0]) - ba.w.dot(f.ra_x_t[0]),
                                m.tangent2.dot(dv_lin) + bb.w.dot(f.rb_x_t[1]) - ba.w.dot(f.ra_x_t[1]));
       Eigen::Vector2d d_lambda;
@@ -287,7 +290,7 @@ inline void solve_contacts(ActiveManifolds manifolds, std::vector<SolverBody>& b
     // Non-penetration.
     for (int k = 0; k < m.count; ++k) {
       auto& p = m.points[static_cast<std::size_t>(k)];
-      const double vn = n.dot(bb.v - ba.v) + bb.w.dot(p.rb_x_n) - ba.w.dot(p.ra_x_n);
+      const double vn = n.dot(bb.v - ba.v + m.surface_velocity) + bb.w.dot(p.rb_x_n) - ba.w.dot(p.ra_x_n);
       const double sep = use_bias ? p.separation : p.relax_separation;
       double bias = 0, mass_scale = 1, impulse_scale = 0;
       if (sep > 0) {
@@ -321,14 +324,14 @@ inline void update_after_position_integration(ActiveManifolds manifolds, std::ve
     double total_normal = 0;
     for (int k = 0; k < m.count; ++k) {
       auto& p = m.points[static_cast<std::size_t>(k)];
-      p.relax_separation = p.separation + s.h * m.normal.dot(detail::relative_velocity(ba, bb, p.ra, p.rb));
+      p.relax_separation = p.separation + s.h * m.normal.dot(detail::relative_velocity(ba, bb, p.ra, p.rb) + m.surface_velocity);
       total_normal += p.normal_impulse;
     }
     auto& f = m.patch;
     if (f.sliding || total_normal <= 0) {
       f.drift_2d.setZero();
     } else {
-      const Vec3 dv = detail::relative_velocity(ba, bb, f.ra, f.rb);
+      const Vec3 dv = detail::relative_velocity(ba, bb, f.ra, f.rb) + m.surface_velocity;
       f.drift_2d += s.h * Eigen::Vector2d(m.tangent1.dot(dv), m.tangent2.dot(dv));
     }
     if (f.twisting || total_normal <= 0) {
@@ -349,7 +352,7 @@ inline void apply_restitution(ActiveManifolds manifolds, std::vector<SolverBody>
     for (int k = 0; k < m.count; ++k) {
       auto& p = m.points[static_cast<std::size_t>(k)];
       if (p.relative_velocity > -s.restitution_threshold || p.max_normal_impulse == 0) continue;
-      const double vn = m.normal.dot(detail::relative_velocity(ba, bb, p.ra, p.rb));
+      const double vn = m.normal.dot(detail::relative_velocity(ba, bb, p.ra, p.rb) + m.surface_velocity);
       const double impulse = -p.normal_mass * (vn + m.restitution * p.relative_velocity);
       const double lambda = std::max(p.normal_impulse + impulse, 0.0);
       detail::apply_impulse(ba, bb, p.ra, p.rb, (lambda - p.normal_impulse) * m.normal);

@@ -313,7 +313,8 @@ class PickPlaceRunner {
             }
           }
           break;
-        case 2: {  // closed this step: did it grasp?
+        case 2: {  // closing: did it grasp?
+          if (world_.gripper().closing()) break;
           const auto held = world_.gripper().held();
           if (!held || *held != object_) {
             res.failure = "missed_grasp";

@@ -9,20 +9,27 @@
 // palm_thickness + finger_length, their inner faces at x = +-open_width / 2. The grasp region is
 // the box between the inner faces over the fingers' length and width.
 //
-// Grasp mechanism (honest, not friction): the fingers' collision shapes stay at the open width.
-// When S goes 0 -> 1, the dynamic body whose geometry overlaps the grasp region deepest (ties:
-// lowest id) is welded to the gripper at its current relative pose by a stiff 6-DoF
-// spring-damper (like the coupling):
+// Fingers: the two finger boxes are geometry of the gripper body that moves along the closing
+// axis (RigidWorld::set_geom_translation): the gap between their inner faces goes from open_width
+// to 0 in stroke_time (both fingers at open_width / (2 stroke_time)), so they collide with what is
+// between them at every width and a closed gripper never passes through an object; the body's
+// mass properties stay those of the open gripper. The contact solver sees the finger surfaces
+// move (RigidGeom::surface_velocity), so a closing finger pushes what it meets at its own speed.
+//
+// Grasp mechanism (a weld with checks, not friction): while the fingers close, the first dynamic
+// body that both fingers touch (within touch_tolerance; ties: lowest id) is welded to the gripper
+// at its current relative pose, and the fingers stop there (finger_width() = the gap at the
+// grasp). The weld is a stiff 6-DoF spring-damper (like the coupling):
 //   F = -k (x_o - x_a) - c (v_o - v_a),  M = -k_r Log(R_o R_a^T) - c_r (w_o - w_g)     (lab)
 // on the object at its centre of mass x_o, the opposite force at x_o on the gripper and the
 // opposite torque (so the pair conserves momentum); x_a, R_a: the object's pose frozen in the
 // gripper frame at the grasp. The held object keeps colliding with everything (table, obstacles,
-// other objects, the rod). Closing on nothing grasps nothing (and a closed gripper picks up nothing
-// it bumps into later); S 1 -> 0 removes the weld. A real grip holds only up to its friction
-// force: when the spring force |k dx| exceeds max_hold_force (or |k_r dtheta| max_hold_torque)
-// the object slips out and the grasp ends (reported by `slipped()`). The visible finger width is
-// open_width when open, the object's extent along the closing axis when holding, 0 when closed
-// on nothing (finger_width(); the collision fingers do not move).
+// other objects, the rod, the fingers). Closing on nothing closes the fingers to 0 and grasps
+// nothing (a closed gripper picks up nothing it bumps into later); S 1 -> 0 removes the weld at
+// once and the fingers open at the stroke speed. A real grip holds only up to its friction force:
+// when the spring force |k dx| exceeds max_hold_force (or |k_r dtheta| max_hold_torque) the object
+// slips out and the grasp ends (reported by `slipped()`); the fingers then stay where they stopped
+// until opened.
 //
 // Stability (explicit forces at dt = 2e-4 s): k and k_r are capped at grasp time so that
 // sqrt(k / m_eff) dt and sqrt(k_r / I_eff) dt stay <= max_omega_dt (0.25) on the pair's reduced
@@ -64,6 +71,8 @@ struct ParallelGripperParameters {
   double max_omega_dt = 0.25;      ///< cap on the weld's stiffness (explicit stability)
   double max_hold_force = 40;      ///< N: grip friction limit (2 fingers x 25 N x mu 0.8)
   double max_hold_torque = 1.5;    ///< N m
+  double stroke_time = 0.1;        ///< s: fingers from open to closed (the gap closes at open_width / stroke_time)
+  double touch_tolerance = 5e-4;   ///< m: a finger this near a body touches it (the grasp's check)
 
   void validate() const {
     manisoft::detail::require_positive("ParallelGripper palm_half_x", palm_half_x);
@@ -82,6 +91,8 @@ struct ParallelGripperParameters {
     if (!(max_omega_dt <= 0.5)) manisoft::detail::fail("ParallelGripper max_omega_dt = ", max_omega_dt, " must be <= 0.5");
     manisoft::detail::require_positive("ParallelGripper max_hold_force", max_hold_force);
     manisoft::detail::require_positive("ParallelGripper max_hold_torque", max_hold_torque);
+    manisoft::detail::require_positive("ParallelGripper stroke_time", stroke_time);
+    manisoft::detail::require_non_negative("ParallelGripper touch_tolerance", touch_tolerance);
     if (palm_half_x < 0.5 * open_width + finger_thickness - 1e-9) {
       manisoft::detail::fail("ParallelGripper palm_half_x = ", palm_half_x, " must cover the fingers (open_width / 2 + finger_thickness = ",
                    0.5 * open_width + finger_thickness, ")");
@@ -89,7 +100,10 @@ struct ParallelGripperParameters {
   }
   /// Centre of the grasp region in the gripper frame.
   Eigen::Vector3d grasp_center() const { return {0, 0, palm_thickness + 0.5 * finger_length}; }
-  Eigen::Vector3d grasp_half_extents() const { return {0.5 * open_width, finger_half_width, 0.5 * finger_length}; }
+  /// Centre of finger `side` (-1 or +1) in the gripper frame at finger gap `gap`.
+  Eigen::Vector3d finger_center(double side, double gap) const {
+    return {side * (0.5 * gap + 0.5 * finger_thickness), 0, palm_thickness + 0.5 * finger_length};
+  }
 };
 
 /// The gripper as an end-effector: compound body (palm + two fingers), attached at the palm's top
@@ -104,8 +118,7 @@ inline interaction::EndEffectorDesc make_parallel_gripper(const ParallelGripperP
   for (double side : {-1.0, 1.0}) {
     geometry::CompoundPart<double> finger;
     finger.shape = geometry::Box<double>{Eigen::Vector3d(0.5 * p.finger_thickness, p.finger_half_width, 0.5 * p.finger_length)};
-    finger.position = Eigen::Vector3d(side * (0.5 * p.open_width + 0.5 * p.finger_thickness), 0,
-                                      p.palm_thickness + 0.5 * p.finger_length);
+    finger.position = p.finger_center(side, p.open_width);
     c.parts.push_back(finger);
   }
   interaction::EndEffectorDesc ee;
@@ -129,6 +142,9 @@ class ParallelGripper {
   /// world's rollback copies it whole.
   struct Snapshot {
     int command = 0, state = 0;
+    double gap = 0;        ///< m: between the fingers' inner faces
+    double gap_rate = 0;   ///< m/s: how fast the gap changed in the last step (the fingers' surface speed x 2)
+    bool stopped = false;  ///< the fingers stopped on a grasped object (until opened)
     std::optional<rigid::BodyId> held, last_released;
     double held_width = 0;
     Vec3 anchor_local = Vec3::Zero();
@@ -144,7 +160,7 @@ class ParallelGripper {
   ParallelGripper() : ParallelGripper(ParallelGripperParameters{}) {}
   explicit ParallelGripper(const ParallelGripperParameters& p) : params_(p) {
     params_.validate();
-    region_ = contact::make_collision_shape(geometry::Box<double>{params_.grasp_half_extents()});
+    m_.gap = params_.open_width;
   }
 
   const ParallelGripperParameters& parameters() const { return params_; }
@@ -161,8 +177,12 @@ class ParallelGripper {
   /// The state S the gripper is in (after the last pre_step).
   int state() const { return m_.state; }
   std::optional<rigid::BodyId> held() const { return m_.held; }
-  /// Visible distance between the fingers [m] (see the header comment).
-  double finger_width() const { return m_.state == 0 ? params_.open_width : (m_.held ? m_.held_width : 0.0); }
+  /// Distance between the fingers' inner faces [m] (see the header comment).
+  double finger_width() const { return m_.gap; }
+  /// Commanded closed, the fingers still moving and nothing grasped yet.
+  bool closing() const { return m_.state == 1 && !m_.held && !m_.stopped && m_.gap > 0; }
+  /// Commanded open and the fingers not yet fully open.
+  bool opening() const { return m_.state == 0 && m_.gap < params_.open_width; }
   /// The weld wrench on the held object in the last step (lab) and its elastic parts.
   const Vec3& weld_force() const { return m_.weld_force; }
   const Vec3& weld_torque() const { return m_.weld_torque; }
@@ -178,33 +198,8 @@ class ParallelGripper {
     return world.position(body_) + world.orientation(body_).toRotationMatrix() * params_.grasp_center();
   }
 
-  /// The dynamic body overlapping the grasp region deepest, if any (no side effects).
-  std::optional<rigid::BodyId> find_graspable(rigid::RigidWorld& world) {
-    const Mat3 rg = world.orientation(body_).toRotationMatrix();
-    contact::Pose region_pose;
-    region_pose.rotation = rg;
-    region_pose.translation = world.position(body_) + rg * params_.grasp_center();
-    std::optional<rigid::BodyId> best;
-    double best_depth = -1;
-    for (rigid::BodyId b = 0; b < world.body_count(); ++b) {
-      if (b == body_ || world.model(b).is_static) continue;
-      const auto& m = world.model(b);
-      if ((world.center_of_mass(b) - region_pose.translation).norm() > m.bounding_radius + region_.bounding_radius) continue;
-      for (std::uint32_t g = m.first_geom; g < m.first_geom + m.geom_count; ++g) {
-        if (!contact::collide(region_, region_pose, world.geoms()[g].shape, world.geom_pose(g), 0.0, set_, scratch_)) continue;
-        for (int i = 0; i < set_.count; ++i) {
-          const double depth = -set_.points[std::size_t(i)].separation;
-          if (depth >= 0 && depth > best_depth) {
-            best_depth = depth;
-            best = b;
-          }
-        }
-      }
-    }
-    return best;
-  }
-
-  /// Before each world step: handles S transitions, applies the weld wrench, checks slip.
+  /// Before each world step: handles S transitions, moves the fingers, grasps what both touch,
+  /// applies the weld wrench, checks slip.
   void pre_step(rigid::RigidWorld& world, double dt) {
     m_.grasped_now = m_.released_now = m_.slipped = false;
     m_.weld_force.setZero();
@@ -212,14 +207,30 @@ class ParallelGripper {
     m_.elastic_force = 0;
     if (m_.command != m_.state) {
       m_.state = m_.command;
-      if (m_.state == 1) {
-        if (auto b = find_graspable(world)) start_weld(world, *b, dt);
-      } else if (m_.held) {
-        release();
+      if (m_.state == 0) {
+        if (m_.held) release();
+        m_.stopped = false;
+      }
+    }
+    const double rate = params_.open_width / params_.stroke_time;
+    const double gap = m_.state == 1 ? (m_.stopped ? m_.gap : std::max(0.0, m_.gap - rate * dt))
+                                     : std::min(params_.open_width, m_.gap + rate * dt);
+    const double gap_rate = (gap - m_.gap) / dt;
+    if (gap != m_.gap || gap_rate != m_.gap_rate) {
+      const bool moved = gap != m_.gap;
+      m_.gap = gap;
+      m_.gap_rate = gap_rate;
+      place_fingers(world, moved);
+      if (moved && m_.state == 1) {
+        if (auto b = touched_by_both(world)) start_weld(world, *b, dt);
       }
     }
     if (m_.held) apply_weld(world);
   }
+
+  /// Puts the finger geometry where the state has it (after a restore: the contact caches are
+  /// those of that state, so nothing is re-detected).
+  void sync(rigid::RigidWorld& world) const { place_fingers(world, false); }
 
  private:
   void release() {
@@ -241,21 +252,9 @@ class ParallelGripper {
     const Vec3 xo = world.center_of_mass(b);
     m_.anchor_local = rg.transpose() * (xo - xg);
     m_.rotation_local = rg.transpose() * world.orientation(b).toRotationMatrix();
-    // Visible width: the object's extent along the closing axis inside the open fingers.
-    double lo = INFINITY, hi = -INFINITY;
     const auto& m = world.model(b);
-    for (std::uint32_t g = m.first_geom; g < m.first_geom + m.geom_count; ++g) {
-      const contact::Pose gp = world.geom_pose(g);
-      contact::Pose local;
-      local.rotation = rg.transpose() * gp.rotation;
-      local.translation = rg.transpose() * (gp.translation - xg);
-      Vec3 glo, ghi;
-      world.geoms()[g].shape.bounds(local, glo, ghi);
-      lo = std::min(lo, glo.x());
-      hi = std::max(hi, ghi.x());
-    }
-    const double half = 0.5 * params_.open_width;
-    m_.held_width = std::max(0.0, std::min(hi, half) - std::max(lo, -half));
+    m_.held_width = m_.gap;
+    m_.stopped = true;
     // Stiffness caps on the pair's reduced mass and inertia (the force acts at x_o, a lever
     // |x_o - x_g,com| on the gripper).
     const auto& mg = world.model(body_);
@@ -292,8 +291,46 @@ class ParallelGripper {
     world.add_torque(body_, -m_.weld_torque);
   }
 
+  /// The finger geometries are the gripper compound's parts 1 (side -1) and 2 (side +1); each
+  /// moves at half the gap's rate.
+  void place_fingers(rigid::RigidWorld& world, bool redetect) const {
+    const Vec3 com = world.model(body_).center_of_mass;
+    for (int i = 0; i < 2; ++i) {
+      const double side = i == 0 ? -1.0 : 1.0;
+      const std::uint32_t g = world.model(body_).first_geom + std::uint32_t(1 + i);
+      const Vec3 local = params_.finger_center(side, m_.gap) - com;
+      const Vec3 velocity(0.5 * side * m_.gap_rate, 0, 0);
+      if (redetect || world.geoms()[g].local.translation != local || world.geoms()[g].surface_velocity != velocity) {
+        world.set_geom_translation(g, local, velocity, redetect);
+      }
+    }
+  }
+
+  /// The dynamic body (lowest id) that both fingers touch, if any.
+  std::optional<rigid::BodyId> touched_by_both(rigid::RigidWorld& world) {
+    const std::uint32_t first = world.model(body_).first_geom;
+    const contact::Pose fingers[2] = {world.geom_pose(first + 1), world.geom_pose(first + 2)};
+    const double reach = world.geoms()[first + 1].shape.bounding_radius;
+    for (rigid::BodyId b = 0; b < world.body_count(); ++b) {
+      if (b == body_ || world.model(b).is_static) continue;
+      const auto& m = world.model(b);
+      bool touched[2] = {false, false};
+      for (int i = 0; i < 2; ++i) {
+        if ((world.center_of_mass(b) - fingers[i].translation).norm() > m.bounding_radius + reach + params_.touch_tolerance) continue;
+        for (std::uint32_t g = m.first_geom; g < m.first_geom + m.geom_count && !touched[i]; ++g) {
+          if (!contact::collide(world.geoms()[first + 1 + std::uint32_t(i)].shape, fingers[i], world.geoms()[g].shape, world.geom_pose(g),
+                                params_.touch_tolerance, set_, scratch_)) {
+            continue;
+          }
+          for (int k = 0; k < set_.count && !touched[i]; ++k) touched[i] = set_.points[std::size_t(k)].separation <= params_.touch_tolerance;
+        }
+      }
+      if (touched[0] && touched[1]) return b;
+    }
+    return std::nullopt;
+  }
+
   ParallelGripperParameters params_;
-  contact::CollisionShape region_;
   contact::ContactSet set_;
   contact::NarrowPhaseScratch scratch_;
   rigid::BodyId body_ = 0;

@@ -62,6 +62,7 @@ struct CapsuleContact {
 struct RigidGeom {
   BodyId body{0};
   contact::Pose local;  ///< relative to the body's centre-of-mass frame
+  contact::Vec3 surface_velocity{contact::Vec3::Zero()};  ///< of the geometry relative to its body, body frame (a moving finger)
   contact::CollisionShape shape;
   contact::Vec3 fat_lo{contact::Vec3::Zero()}, fat_hi{contact::Vec3::Zero()};
 };
@@ -286,6 +287,8 @@ class RigidWorld {
       auto& m = manifolds_[i];
       if (m.count == 0 || !(is_moving(m.body_a) || is_moving(m.body_b))) continue;
       record_manifold(i);  // its impulses and friction drift change below
+      m.surface_velocity = states_[m.body_b].rotation * geoms_[m.geom_b].surface_velocity -
+                           states_[m.body_a].rotation * geoms_[m.geom_a].surface_velocity;
       active_.push_back(&m);
     }
     std::sort(active_.begin(), active_.end(), [](const contact::ContactManifold* a, const contact::ContactManifold* b) { return a->key() < b->key(); });
@@ -489,6 +492,33 @@ class RigidWorld {
       manager_->update(fcl_objects_[g].get());
     }
     broadphase_dirty_ = true;
+  }
+
+  /// Moves geometry g within its body (a gripper's finger): its translation relative to the
+  /// body's centre-of-mass frame and the velocity it moves at relative to the body (body frame;
+  /// the contact solver sees its surface move, so a finger pushes what it closes on at its own
+  /// speed). The body's mass properties stay as built and the geometry must stay within the
+  /// body's bounding radius. With `redetect`, its cached contacts are re-detected at the next step
+  /// (without: the caches already belong to this placement, as after a restore).
+  void set_geom_translation(std::uint32_t g, const Vec3& local, const Vec3& velocity, bool redetect = true) {
+    if (g >= geoms_.size()) ::manisoft::detail::fail("geometry id ", g, " out of range (", geoms_.size(), " geometries)");
+    auto& geom = geoms_[g];
+    const auto& model = models_[geom.body];
+    if (!local.allFinite() || !velocity.allFinite() || local.norm() + geom.shape.bounding_radius > model.bounding_radius + 1e-12) {
+      ::manisoft::detail::fail("geometry ", g, " of rigid body ", geom.body, describe(geom.body), ": translation (", local.transpose(),
+                               ") or velocity (", velocity.transpose(), ") is not finite or the translation leaves the body's bounding radius ",
+                               model.bounding_radius, " m");
+    }
+    geom.local.translation = local;
+    geom.surface_velocity = velocity;
+    if (!redetect) return;
+    if (!model.is_static) states_[geom.body].sleep_time = 0;
+    for (std::size_t i = 0; i < manifolds_.size(); ++i) {
+      auto& m = manifolds_[i];
+      if (m.fresh || (m.geom_a != g && m.geom_b != g)) continue;
+      record_manifold(i);
+      m.fresh = true;
+    }
   }
 
   /// World placement of geometry g.

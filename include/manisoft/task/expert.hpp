@@ -41,7 +41,8 @@
 // symmetric equivalent nearest the held one; the corrected carry is checked again and, when
 // refused, the other kind of carry tried), lowered once the arm's tip is slower than
 // carry_settle_speed: at lower_peak_speed, a long lower (into a container) at the carry's speed
-// until slow_lower above its end first, open once settled or as soon as the support carries the object (a tall
+// until slow_lower above its end first, open once settled or as soon as the support carries the object or the
+// gripper touches anything else (the closed fingers on a bowl below: fingers_blocked) (a tall
 // one, height above tall_ratio x width, is lowered on until its support carries it, contact_depth
 // below, so it is not dropped onto its rim; the arm stops there, release_lift up, and opens once
 // its tip is slower than release_settle_speed), then up at retract_peak_speed until the
@@ -856,6 +857,22 @@ class Expert {
     return o.touching != 0 || o.touches_table || o.pose.translation.z() < plan_.object_target.translation.z() - 0.5 * config_.place_clearance;
   }
 
+  /// Whether the gripper touches anything but the held object: the closed fingers, at the held
+  /// object's width, land on the rim or inner wall of a bowl below before the held bowl nests in
+  /// it (the lower then opens there and the object drops the rest of the way).
+  bool fingers_blocked(const TaskEnv::World& w) const {
+    const rigid::BodyId g = w.gripper_body(), held = env_->bodies().objects[static_cast<std::size_t>(plan_.object)];
+    const double margin = TaskEnv::contact_margin;
+    for (const auto& m : w.rigid().manifolds()) {
+      if (m.count == 0 || (m.body_a != g && m.body_b != g)) continue;
+      const rigid::BodyId other = m.body_a == g ? m.body_b : m.body_a;
+      if (other == held) continue;
+      for (int k = 0; k < m.count; ++k)
+        if (m.points[static_cast<std::size_t>(k)].separation <= margin) return true;
+    }
+    return false;
+  }
+
   /// Above the place pose by retract_height, or more until the fingertips are finger_clearance
   /// above the released object's top.
   Pose retract_pose() const {
@@ -907,6 +924,7 @@ class Expert {
         }
         break;
       case ExpertPhase::close: {
+        if (!holding && w.gripper().closing()) break;  // the fingers are still on their way
         if (!holding) {
           s_ = 0;
           if (retries_++ < config_.max_retries) {
@@ -997,7 +1015,7 @@ class Expert {
         // until it slips.
         // With release_settle_speed, the arm stops where it is first and opens once its tip is
         // slower (a tall object let go while the arm still sways tips over).
-        if (!touched_ && supported(state_of(plan_.object))) {
+        if (!touched_ && (supported(state_of(plan_.object)) || fingers_blocked(w))) {
           touched_ = true;
           waited_ = 0;
           if (release_settles()) {

@@ -87,6 +87,7 @@ struct StepInfo {
 
 class TaskEnv {
  public:
+  static constexpr double contact_margin = 1e-3;  ///< m: closer than this counts as touching (predicates, expert)
   using Rod = rod::CosseratRod<double, rod::damping::AnalyticalLinear, rod::bc::ClampedBase, rod::integrator::PositionVerlet,
                                rod::forcing::Gravity, rod::forcing::ElementTorques>;
   using World = world::ArmWorld<Rod>;
@@ -327,8 +328,6 @@ class TaskEnv {
     info_.failure = reason;
     return info_;
   }
-
-  static constexpr double contact_margin = 1e-3;  ///< m: closer than this counts as touching
 
   const scene::AssetLibrary* library_;
   TaskEnvConfig config_;

@@ -13,7 +13,7 @@
 // Step (explicit, loads from the state at the start of the step):
 //   0. one snapshot of everything the step changes (rod state and counter, rigid bodies and their
 //      contact caches, rod-contact friction anchors, device state, counters),
-//   1. device pre-step (gripper: S transitions, weld wrench on a held object),
+//   1. device pre-step (gripper: S transitions, finger motion, weld wrench on a held object),
 //   2. coupling wrench from the tip and attachment frames; -wrench on the rod tip,
 //   3. rod contact loads (policy),
 //   4. rod step, then +wrench on the end-effector and the rigid step.
@@ -43,6 +43,7 @@ struct NoDevice {
   void pre_step(rigid::RigidWorld&, double) {}
   void save(Snapshot&) const {}
   void restore(const Snapshot&) {}
+  void sync(rigid::RigidWorld&) const {}
 };
 
 template <typename Rod, typename Coupling = interaction::ElasticSpring, typename RodContact = interaction::NoRodContact,
@@ -131,6 +132,7 @@ class SoftArmWorld {
     rigid_.clear_external_loads();
     rod_contact_.restore(in.rod_contact);
     device_.restore(in.device);
+    device_.sync(rigid_);  // geometry the device moves (the fingers) back where the state has it
     last_wrench_ = in.last_wrench;
     step_count_ = in.step_count;
   }
