@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   app.add_option("--arm-clearance", expert_config.arm_clearance, "expert: the rod clear of objects and obstacles along planned lines, m")->check(CLI::NonNegativeNumber);
   bool no_arm_check = false;
   app.add_flag("--no-arm-check", no_arm_check, "expert: do not check planned lines against objects and obstacles");
+  app.add_option("--stack-finger-clearance", expert_config.stack_finger_clearance, "expert: STK: the fingertips above the item below's top when released, m")->check(CLI::NonNegativeNumber);
   app.add_option("--place-clearance", expert_config.place_clearance, "expert: the object's bottom above its support when released, m")->check(CLI::NonNegativeNumber);
   app.add_option("--approach-distance", expert_config.approach_distance, "expert: approach pose distance from the grasp, m")->check(CLI::PositiveNumber);
   app.add_option("--settle-error", expert_config.settle_error, "expert: close / open once the end-effector is this near its pose, m")->check(CLI::PositiveNumber);

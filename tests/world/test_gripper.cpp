@@ -2,7 +2,8 @@
 // every step, gravity cancelled) above a table: the fingers move at open_width / stroke_time,
 // closing on an object between them grasps it where both touch it and lifts it (sag m g / k), an
 // off-centre object is pushed to the middle, closing on nothing grasps nothing, a closed gripper
-// lands on an object instead of passing around it, opening releases (the object falls back onto
+// lands on an object instead of passing around it, opening stops while something presses on a
+// finger's outer face, opening releases (the object falls back onto
 // the table), a held object still collides with the world (a wall stops it, and pushing on makes
 // the grasp slip at the hold-force limit), bad commands are refused.
 #include <catch2/catch.hpp>
@@ -216,6 +217,37 @@ TEST_CASE("a closed gripper lands on an object instead of passing around it", "[
   CHECK(tips < 2 * s.cube_half + 1e-3);
   CHECK(s.world.center_of_mass(s.cube).z() == Approx(s.cube_half).margin(2e-3));
   CHECK_FALSE(s.gripper.held());
+}
+
+TEST_CASE("opening stops while something presses on a finger's outer face", "[world][gripper]") {
+  Scene s(0.0);
+  s.gripper.command(1);
+  s.run(Vector3d::Zero(), 0.1);
+  REQUIRE(s.gripper.held());
+  const double held_width = s.gripper.finger_width();
+  // A static block 4 cm high just outside the +x finger (its outer face at held_width / 2 +
+  // finger_thickness; the block 0.2 mm beyond): opening would push into it.
+  const auto& p = s.gripper.parameters();
+  const double face = 0.5 * held_width + p.finger_thickness + 2e-4;
+  manisoft::rigid::RigidBodyDesc block;
+  block.shape = manisoft::geometry::Box<double>{Vector3d(0.03, 0.05, 0.02)};
+  block.position = Vector3d(face + 0.03, 0, 0.02);
+  block.is_static = true;
+  block.name = "block";
+  s.world.add_body(block);
+  s.gripper.command(0);
+  s.run(Vector3d::Zero(), 0.05);  // half a stroke
+  CHECK_FALSE(s.gripper.held());
+  CHECK(s.gripper.finger_width() == Approx(held_width).margin(1e-3));  // stopped by the block
+  CHECK(s.gripper.opening());
+  // Up at 0.2 m/s: the fingertips (5 mm above the table) clear the block's top (4 cm) after
+  // 0.175 s; then the fingers open fully within the rest of a stroke.
+  s.run(Vector3d(0, 0, 0.2), 0.15);
+  CHECK(s.gripper.finger_width() == Approx(held_width).margin(1e-3));
+  s.run(Vector3d(0, 0, 0.2), 0.2);
+  CHECK(s.gripper.finger_width() == Approx(p.open_width));
+  CHECK_FALSE(s.gripper.opening());
+  CHECK(s.world.center_of_mass(s.cube).z() == Approx(s.cube_half).margin(1e-3));  // left on the table
 }
 
 TEST_CASE("the gripper refuses bad commands and parameters", "[world][gripper]") {

@@ -29,7 +29,9 @@
 // once and the fingers open at the stroke speed. A real grip holds only up to its friction force:
 // when the spring force |k dx| exceeds max_hold_force (or |k_r dtheta| max_hold_torque) the object
 // slips out and the grasp ends (reported by `slipped()`); the fingers then stay where they stopped
-// until opened.
+// until opened. Opening is force-limited: while anything presses on a finger's outer face (the
+// wall of a bowl the closed fingers were lowered into), the fingers stop, and go on opening once
+// the arm lifts them clear.
 //
 // Stability (explicit forces at dt = 2e-4 s): k and k_r are capped at grasp time so that
 // sqrt(k / m_eff) dt and sqrt(k_r / I_eff) dt stay <= max_omega_dt (0.25) on the pair's reduced
@@ -213,8 +215,9 @@ class ParallelGripper {
       }
     }
     const double rate = params_.open_width / params_.stroke_time;
-    const double gap = m_.state == 1 ? (m_.stopped ? m_.gap : std::max(0.0, m_.gap - rate * dt))
-                                     : std::min(params_.open_width, m_.gap + rate * dt);
+    double gap = m_.state == 1 ? (m_.stopped ? m_.gap : std::max(0.0, m_.gap - rate * dt))
+                               : std::min(params_.open_width, m_.gap + rate * dt);
+    if (gap > m_.gap && opening_blocked(world)) gap = m_.gap;
     const double gap_rate = (gap - m_.gap) / dt;
     if (gap != m_.gap || gap_rate != m_.gap_rate) {
       const bool moved = gap != m_.gap;
@@ -306,28 +309,42 @@ class ParallelGripper {
     }
   }
 
+  /// Whether finger i (0: side -1, 1: side +1) touches body b within touch_tolerance; with
+  /// `outward` (world, unit), only on its outer face (the contact normal within 60 degrees of it).
+  bool finger_touches(rigid::RigidWorld& world, int i, rigid::BodyId b, const Vec3* outward) {
+    const std::uint32_t fg = world.model(body_).first_geom + std::uint32_t(1 + i);
+    const contact::Pose fp = world.geom_pose(fg);
+    const auto& m = world.model(b);
+    if ((world.center_of_mass(b) - fp.translation).norm() > m.bounding_radius + world.geoms()[fg].shape.bounding_radius + params_.touch_tolerance) {
+      return false;
+    }
+    for (std::uint32_t g = m.first_geom; g < m.first_geom + m.geom_count; ++g) {
+      if (!contact::collide(world.geoms()[fg].shape, fp, world.geoms()[g].shape, world.geom_pose(g), params_.touch_tolerance, set_, scratch_)) continue;
+      if (outward && set_.normal.dot(*outward) < 0.5) continue;
+      for (int k = 0; k < set_.count; ++k)
+        if (set_.points[std::size_t(k)].separation <= params_.touch_tolerance) return true;
+    }
+    return false;
+  }
+
   /// The dynamic body (lowest id) that both fingers touch, if any.
   std::optional<rigid::BodyId> touched_by_both(rigid::RigidWorld& world) {
-    const std::uint32_t first = world.model(body_).first_geom;
-    const contact::Pose fingers[2] = {world.geom_pose(first + 1), world.geom_pose(first + 2)};
-    const double reach = world.geoms()[first + 1].shape.bounding_radius;
     for (rigid::BodyId b = 0; b < world.body_count(); ++b) {
       if (b == body_ || world.model(b).is_static) continue;
-      const auto& m = world.model(b);
-      bool touched[2] = {false, false};
-      for (int i = 0; i < 2; ++i) {
-        if ((world.center_of_mass(b) - fingers[i].translation).norm() > m.bounding_radius + reach + params_.touch_tolerance) continue;
-        for (std::uint32_t g = m.first_geom; g < m.first_geom + m.geom_count && !touched[i]; ++g) {
-          if (!contact::collide(world.geoms()[first + 1 + std::uint32_t(i)].shape, fingers[i], world.geoms()[g].shape, world.geom_pose(g),
-                                params_.touch_tolerance, set_, scratch_)) {
-            continue;
-          }
-          for (int k = 0; k < set_.count && !touched[i]; ++k) touched[i] = set_.points[std::size_t(k)].separation <= params_.touch_tolerance;
-        }
-      }
-      if (touched[0] && touched[1]) return b;
+      if (finger_touches(world, 0, b, nullptr) && finger_touches(world, 1, b, nullptr)) return b;
     }
     return std::nullopt;
+  }
+
+  /// Whether anything presses on a finger's outer face (the opening stops there).
+  bool opening_blocked(rigid::RigidWorld& world) {
+    const Vec3 x = world.orientation(body_).toRotationMatrix().col(0);
+    const Vec3 outward[2] = {-x, x};
+    for (rigid::BodyId b = 0; b < world.body_count(); ++b) {
+      if (b == body_) continue;
+      if (finger_touches(world, 0, b, &outward[0]) || finger_touches(world, 1, b, &outward[1])) return true;
+    }
+    return false;
   }
 
   ParallelGripperParameters params_;

@@ -11,7 +11,8 @@
 //         floor when the open gripper fits into the opening: the basket);
 //   ALN   the object at the goal pose (the symmetric equivalent nearest its current yaw);
 //   STK   items[k] onto items[k-1] for k = 1, 2, ... (on the receptacle of the item below, or on
-//         its top), the item below read when the move starts;
+//         its top), the item below read when the move starts; released with the fingertips
+//         stack_finger_clearance above the item below's top (the item drops the rest);
 //   ARR   each relation's object at the free spot the scene gives for it (Relation::spots).
 // Orientation: kept as the object stands (translation only) except ALN's yaw.
 // Grasp: among the asset's annotated grasps, each also turned half a turn about the fingers' axis
@@ -93,6 +94,7 @@ struct ExpertConfig {
   double place_clearance = 0.008;   ///< m: the object's bottom above its support when released
   double retract_height = 0.06;     ///< m: up after every release (at least)
   double finger_clearance = 0.02;   ///< m: and until the fingertips are this far above the released object's top
+  double stack_finger_clearance = 0.0;  ///< m: STK: the lower stops with the fingertips this far above the item below's top (lower_goal)
   double path_peak_speed = 1.5;     ///< m/s, peak end-effector speed of a path's quintic timing (gripper empty)
   double max_node_speed = 1.5;      ///< m/s, planned peak speed of any rod node (gripper empty)
   double carry_peak_speed = 1.2;    ///< m/s, the same while an object is held
@@ -846,9 +848,16 @@ class Expert {
 
   /// The end of the lower line: the place pose; for a tall object (release_settles()) lowered
   /// on by place_clearance + contact_depth, so that it reaches its support and is not dropped.
+  /// STK: no lower than where the fingertips are stack_finger_clearance above the item below's
+  /// top (the closed fingers, at the held item's width, would land on its rim or inner wall
+  /// before the held item nests); the item drops the rest of the way.
   Pose lower_goal() const {
     Pose p = plan_.place;
     if (release_settles() && config_.contact_depth > 0) p.translation.z() -= config_.place_clearance + config_.contact_depth;
+    if (env_->spec().task == scene::Task::stk) {
+      const double lowest = top_of(support_of(move_)) + config_.stack_finger_clearance;
+      p.translation.z() += std::max(0.0, lowest - fingertips(p).z());
+    }
     return p;
   }
 
