@@ -148,7 +148,6 @@ class ParallelGripper {
     double gap_rate = 0;   ///< m/s: how fast the gap changed in the last step (the fingers' surface speed x 2)
     bool stopped = false;  ///< the fingers stopped on a grasped object (until opened)
     std::optional<rigid::BodyId> held, last_released;
-    double held_width = 0;
     Vec3 anchor_local = Vec3::Zero();
     Mat3 rotation_local = Mat3::Identity();
     double k = 0, k_r = 0, c = 0, c_r = 0;
@@ -256,7 +255,6 @@ class ParallelGripper {
     m_.anchor_local = rg.transpose() * (xo - xg);
     m_.rotation_local = rg.transpose() * world.orientation(b).toRotationMatrix();
     const auto& m = world.model(b);
-    m_.held_width = m_.gap;
     m_.stopped = true;
     // Stiffness caps on the pair's reduced mass and inertia (the force acts at x_o, a lever
     // |x_o - x_g,com| on the gripper).
