@@ -871,13 +871,9 @@ class Expert {
   /// it (the lower then opens there and the object drops the rest of the way).
   bool fingers_blocked(const TaskEnv::World& w) const {
     const rigid::BodyId g = w.gripper_body(), held = env_->bodies().objects[static_cast<std::size_t>(plan_.object)];
-    const double margin = TaskEnv::contact_margin;
     for (const auto& m : w.rigid().manifolds()) {
-      if (m.count == 0 || (m.body_a != g && m.body_b != g)) continue;
-      const rigid::BodyId other = m.body_a == g ? m.body_b : m.body_a;
-      if (other == held) continue;
-      for (int k = 0; k < m.count; ++k)
-        if (m.points[static_cast<std::size_t>(k)].separation <= margin) return true;
+      if (m.body_a != g && m.body_b != g) continue;
+      if ((m.body_a == g ? m.body_b : m.body_a) != held && TaskEnv::touching(m)) return true;
     }
     return false;
   }

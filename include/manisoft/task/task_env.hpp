@@ -87,7 +87,13 @@ struct StepInfo {
 
 class TaskEnv {
  public:
-  static constexpr double contact_margin = 1e-3;  ///< m: closer than this counts as touching (predicates, expert)
+  /// Whether a contact manifold has a point closer than contact_margin (what the predicates and
+  /// the expert count as touching).
+  static bool touching(const contact::ContactManifold& m) {
+    for (int k = 0; k < m.count; ++k)
+      if (m.points[static_cast<std::size_t>(k)].separation <= contact_margin) return true;
+    return false;
+  }
   using Rod = rod::CosseratRod<double, rod::damping::AnalyticalLinear, rod::bc::ClampedBase, rod::integrator::PositionVerlet,
                                rod::forcing::Gravity, rod::forcing::ElementTorques>;
   using World = world::ArmWorld<Rod>;
@@ -298,9 +304,7 @@ class TaskEnv {
       o.held = held && *held == b;
     }
     for (const auto& m : rigid.manifolds()) {
-      bool touching = false;
-      for (int k = 0; k < m.count; ++k) touching = touching || m.points[static_cast<std::size_t>(k)].separation <= contact_margin;
-      if (!touching) continue;
+      if (!touching(m)) continue;
       const int a = object_of_body_[m.body_a], b = object_of_body_[m.body_b];
       if (a >= 0 && b >= 0) {
         states_[static_cast<std::size_t>(a)].touching |= std::uint64_t(1) << b;
@@ -328,6 +332,8 @@ class TaskEnv {
     info_.failure = reason;
     return info_;
   }
+
+  static constexpr double contact_margin = 1e-3;  ///< m: closer than this counts as touching
 
   const scene::AssetLibrary* library_;
   TaskEnvConfig config_;
