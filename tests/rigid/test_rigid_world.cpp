@@ -74,6 +74,42 @@ TEST_CASE("a box resting on the table neither sinks nor drifts", "[world][rest]"
   CHECK(t.out.max_xy_drift < 0.1e-3);
 }
 
+TEST_CASE("an excluded contact is left out, and detected again once the exclusion ends", "[world][exclusion]") {
+  // A cube resting on the table: with the table's geometry excluded against it, it falls freely
+  // (z drops g t^2 / 2); cleared, the contact is found again and stops it, the same as a run that
+  // is saved before and restored after (the exclusion is a setting its owner sets again).
+  rigid::RigidWorld w(awake_settings());
+  const auto s = scenes::build(w, "S1");
+  const BodyId cube = s.bodies[0];
+  const BodyId table = 0;
+  REQUIRE(w.model(table).is_static);
+  for (int i = 0; i < 100; ++i) w.step(kDt);
+  const double z0 = w.center_of_mass(cube).z();
+  const rigid::RigidWorld::ExcludedContact e{w.model(table).first_geom, w.model(table).geom_count, cube};
+  w.set_excluded_contact(e);
+  const int n = 50;  // 10 ms: 0.49 mm of free fall
+  for (int i = 0; i < n; ++i) w.step(kDt);
+  const double t = n * kDt;
+  CHECK(z0 - w.center_of_mass(cube).z() == Approx(0.5 * 9.81 * t * t).epsilon(0.05));
+  for (const auto& m : w.manifolds()) CHECK(m.count == 0);
+  w.set_excluded_contact(std::nullopt);
+  rigid::RigidWorld::Snapshot snap;
+  w.save(snap);
+  for (int i = 0; i < 2000; ++i) w.step(kDt);
+  const Vector3d rested = w.center_of_mass(cube);
+  CHECK(rested.z() == Approx(z0).margin(0.5e-3));  // pushed back out of the table, at rest on it
+  CHECK(w.linear_velocity(cube).norm() < 1e-3);
+  w.set_excluded_contact(e);
+  w.restore(snap);
+  w.set_excluded_contact(std::nullopt);
+  for (int i = 0; i < 2000; ++i) w.step(kDt);
+  CHECK(std::memcmp(w.center_of_mass(cube).data(), rested.data(), sizeof(rested)) == 0);
+  // Geometries of two bodies, or of the other body itself, are refused with the range named.
+  REQUIRE(w.geoms().size() == 2);  // the table's and the cube's
+  CHECK_THROWS_WITH(w.set_excluded_contact(rigid::RigidWorld::ExcludedContact{0, 2, cube}), Contains("excluded contact: geometries [0, 2)"));
+  CHECK_THROWS_WITH(w.set_excluded_contact(rigid::RigidWorld::ExcludedContact{w.model(cube).first_geom, 1, cube}), Contains("other than body"));
+}
+
 TEST_CASE("a sliding box decelerates at mu g", "[world][friction]") {
   rigid::RigidWorld w(awake_settings());
   const auto s = scenes::build(w, "S6");  // 1 m/s, mu = 0.5

@@ -347,7 +347,9 @@ TEST_CASE("a held line's acceleration stays within the grip: a tall bottle is no
   // 10 g and the weld's force passed the grip's max_hold_force (40 N): it slipped out (before the
   // fingers moved; it now holds at a different grasp). Bounded to carry_grip_share x
   // max_hold_force / mass, the lift takes longer: the weld's force over the carry is lower than
-  // unbounded, within the grip, and the bottle stays held.
+  // unbounded, within the grip, and the bottle stays held and ends in the row, at rest (it rocks
+  // on its base for about 230 control steps after the release, so success comes at the horizon
+  // or just after it: the predicate is checked as it holds at the end).
   const SceneSpec s = sample(Task::arr, 44);
   TaskEnv& e = env();
   struct Carry {
@@ -372,7 +374,7 @@ TEST_CASE("a held line's acceleration stays within the grip: a tall bottle is no
   CHECK(bounded.max_force < fast.max_force);
   CHECK(bounded.max_force < e.world().gripper().parameters().max_hold_force);
   CHECK_FALSE(bounded.slipped);
-  CHECK(e.info().success);
+  CHECK(e.success_at_end());
 }
 
 TEST_CASE("the carry lifts the held object and the gripper over the container's rim", "[tasks][expert]") {

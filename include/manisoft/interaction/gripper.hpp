@@ -24,7 +24,9 @@
 // on the object at its centre of mass x_o, the opposite force at x_o on the gripper and the
 // opposite torque (so the pair conserves momentum); x_a, R_a: the object's pose frozen in the
 // gripper frame at the grasp. The held object keeps colliding with everything (table, obstacles,
-// other objects, the rod, the fingers). Closing on nothing closes the fingers to 0 and grasps
+// other objects, the rod, the palm) but the fingers while it is held (RigidWorld::
+// set_excluded_contact: the weld holds it, and the fingers, stopped within touch_tolerance of it,
+// would only add contacts to re-detect at every step of a carry). Closing on nothing closes the fingers to 0 and grasps
 // nothing (a closed gripper picks up nothing it bumps into later); S 1 -> 0 removes the weld at
 // once and the fingers open at the stroke speed. A real grip holds only up to its friction force:
 // when the spring force |k dx| exceeds max_hold_force (or |k_r dtheta| max_hold_torque) the object
@@ -228,11 +230,15 @@ class ParallelGripper {
       }
     }
     if (m_.held) apply_weld(world);
+    exclude_held(world);
   }
 
   /// Puts the finger geometry where the state has it (after a restore: the contact caches are
   /// those of that state, so nothing is re-detected).
-  void sync(rigid::RigidWorld& world) const { place_fingers(world, false); }
+  void sync(rigid::RigidWorld& world) const {
+    place_fingers(world, false);
+    exclude_held(world);
+  }
 
  private:
   void release() {
@@ -290,6 +296,13 @@ class ParallelGripper {
     world.add_force_and_torque(b, m_.weld_force, m_.weld_torque);
     world.add_force_at_point(body_, -m_.weld_force, xo);
     world.add_torque(body_, -m_.weld_torque);
+  }
+
+  /// The weld holds the object: the fingers' contacts with it (they stopped within
+  /// touch_tolerance of it) are left out while it is held; the palm's stay.
+  void exclude_held(rigid::RigidWorld& world) const {
+    if (!m_.held) return world.set_excluded_contact(std::nullopt);
+    world.set_excluded_contact(rigid::RigidWorld::ExcludedContact{world.model(body_).first_geom + 1, 2, *m_.held});
   }
 
   /// The finger geometries are the gripper compound's parts 1 (side -1) and 2 (side +1); each

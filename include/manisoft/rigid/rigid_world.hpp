@@ -27,6 +27,7 @@
 #include <algorithm>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -494,6 +495,29 @@ class RigidWorld {
     broadphase_dirty_ = true;
   }
 
+  /// Contact left out between some geometries of one body and another body (set_excluded_contact).
+  struct ExcludedContact {
+    std::uint32_t first_geom{0}, geom_count{0};  ///< geometries [first_geom, first_geom + geom_count) of one body
+    BodyId body{0};                              ///< ... and every geometry of this (other) body
+  };
+  /// Leaves out contact between some geometries of one body and another body (a gripper's
+  /// fingers and the object its weld holds) until cleared (nullopt) or replaced: their manifolds
+  /// are kept empty, and re-detected from scratch once the exclusion ends. A setting, not state:
+  /// whoever sets it sets it again after a restore (a manifold's memory says whether it was
+  /// excluded, so a replay gives the same contacts).
+  void set_excluded_contact(std::optional<ExcludedContact> e) {
+    if (e) {
+      check_id(e->body);
+      if (e->geom_count == 0 || std::size_t(e->first_geom) + e->geom_count > geoms_.size() ||
+          geoms_[e->first_geom].body != geoms_[e->first_geom + e->geom_count - 1].body || geoms_[e->first_geom].body == e->body) {
+        ::manisoft::detail::fail("excluded contact: geometries [", e->first_geom, ", ", std::size_t(e->first_geom) + e->geom_count,
+                                 ") are not geometries of one body other than body ", e->body, " (", geoms_.size(), " geometries)");
+      }
+    }
+    excluded_ = e;
+  }
+  std::optional<ExcludedContact> excluded_contact() const { return excluded_; }
+
   /// Moves geometry g within its body (a gripper's finger): its translation relative to the
   /// body's centre-of-mass frame and the velocity it moves at relative to the body (body frame;
   /// the contact solver sees its surface move, so a finger pushes what it closes on at its own
@@ -576,6 +600,12 @@ class RigidWorld {
     return k == contact::ShapeKind::sphere || k == contact::ShapeKind::capsule || k == contact::ShapeKind::cylinder;
   }
   bool is_moving(BodyId id) const { return !models_[id].is_static && states_[id].awake; }
+
+  bool excluded(const contact::ContactManifold& m) const {
+    if (!excluded_) return false;
+    const auto in_range = [&](std::uint32_t g) { return g - excluded_->first_geom < excluded_->geom_count; };
+    return (in_range(m.geom_a) && m.body_b == excluded_->body) || (in_range(m.geom_b) && m.body_a == excluded_->body);
+  }
 
   /// Keeps manifold i's memory from before this step's changes to it (slot i after the list's changes).
   void record_manifold(std::size_t i) {
@@ -694,6 +724,15 @@ class RigidWorld {
       const auto ka = geoms_[m.geom_a].shape.kind, kb = geoms_[m.geom_b].shape.kind;
       const bool analytic_round = (is_round(ka) && (is_round(kb) || kb == contact::ShapeKind::box)) ||
                                   (is_round(kb) && ka == contact::ShapeKind::box);
+      if (excluded(m)) {
+        if (m.count > 0 || !m.fresh) {
+          record_manifold(i);
+          m.count = 0;
+          m.patch = {};
+          m.fresh = true;  // re-detected once the exclusion ends
+        }
+        continue;
+      }
       const bool moving = is_moving(m.body_a) || is_moving(m.body_b);
       if (!m.fresh && !((analytic_round || m.rolling) && moving) && (sa.travel - m.travel_a) + (sb.travel - m.travel_b) <= redetect) continue;
       record_manifold(i);
@@ -879,6 +918,7 @@ class RigidWorld {
   };
   StepRecord record_;  ///< what the current step changed (begin_step / undo_step)
   bool recording_{false};
+  std::optional<ExcludedContact> excluded_;  // set_excluded_contact
   std::vector<RigidGeom> geoms_;
   std::vector<std::unique_ptr<detail::FatCollisionObject>> fcl_objects_;
   std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> manager_;

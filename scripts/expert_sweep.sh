@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The expert's success table (issue 13): run_task on train scenes FIRST..LAST of every task and
+# setting (seed 0), JOBS at a time, one JSON line an episode into OUT, then a summary by task and
+# setting: successes, mean steps of the successes, failure reasons.
+#   scripts/expert_sweep.sh RUN_TASK OUT [LAST=199] [FIRST=0] [extra run_task flags...]
+set -euo pipefail
+run_task=$1 out=$2 last=${3:-199} first=${4:-0}
+shift $(( $# < 4 ? $# : 4 ))
+jobs=${JOBS:-2}
+for task in COLL ALN STK ARR; do for setting in clean randomized; do for i in $(seq "$first" "$last"); do
+  echo "$task $setting $i"
+done; done; done | xargs -P"$jobs" -L1 bash -c 'echo "$0 $1 $2 $("'"$run_task"'" --task $0 --setting $1 --index $2 --seed 0 --quiet '"$*"' | tail -1)"' > "$out"
+/usr/bin/python3 - "$out" <<'PY'
+import json, sys, collections
+rows = collections.defaultdict(list)
+for line in open(sys.argv[1]):
+    task, setting, index, js = line.split(" ", 3)
+    rows[(task, setting)].append(json.loads(js))
+total = collections.Counter()
+for (task, setting), eps in sorted(rows.items()):
+    ok = [e for e in eps if e["success"]]
+    fails = collections.Counter(e.get("failure") for e in eps if not e["success"])
+    mean = sum(e["steps"] for e in ok) / max(1, len(ok))
+    print(f"{task:4} {setting:10} {len(ok):3}/{len(eps)} ({100*len(ok)/len(eps):5.1f}%) mean steps {mean:6.0f}  {dict(fails)}")
+    total[setting + "_ok"] += len(ok); total[setting] += len(eps)
+for s in ("clean", "randomized"):
+    if total[s]: print(f"{s}: {total[s+'_ok']}/{total[s]} ({100*total[s+'_ok']/total[s]:.1f}%)")
+PY
