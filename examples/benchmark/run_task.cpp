@@ -71,7 +71,8 @@ int main(int argc, char** argv) {
   app.add_option("--grasp-error", expert_config.grasp_error, "expert: a descent that ends farther from its grasp pose backs off and re-tries, m")->check(CLI::PositiveNumber);
   app.add_option("--via-raise", expert_config.via_raise, "expert: the high variants of a grasp raise their via points this much, m")->check(CLI::NonNegativeNumber);
   app.add_flag("!--estimate-in-contact", expert_config.freeze_estimate_in_contact, "expert: keep the executor's stiffness estimate running while the tool may touch things (descend, close, lower, open)");
-  app.add_option("--tight-clearance", expert_config.tight_clearance, "expert: a grasp whose open fingers clear the object by less a side is descended to at --lower-speed, m (0: never)")->check(CLI::NonNegativeNumber);
+  app.add_option("--tight-clearance", expert_config.tight_clearance, "expert: a grasp whose open fingers clear the object by less a side is descended to at --tight-speed, m (0: never)")->check(CLI::NonNegativeNumber);
+  app.add_option("--tight-speed", expert_config.tight_peak_speed, "expert: peak end-effector speed of the descent to a tight grasp, m/s")->check(CLI::PositiveNumber);
   task::TaskEnvConfig env_config;
   app.add_option("--executor-damping", env_config.executor.damping_gain, "executor: node velocity feedback kd, 1/s")->check(CLI::NonNegativeNumber);
   app.add_option("--executor-stiffness", env_config.executor.position_gain, "executor: node position feedback kp, 1/s^2")->check(CLI::NonNegativeNumber);

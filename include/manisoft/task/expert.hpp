@@ -34,7 +34,7 @@
 // the annotation's approach direction, approach_distance from the grasp; "via": first to above
 // it, for a tall object high enough that the fingertips pass approach_tip_clearance above its top,
 // and higher while the line there would still sweep them into it; candidates whose approach would
-// sweep the open fingers into a tall object come last: approach_clear()), grasp (at lower_peak_speed when the grasp is tight: tight_clearance), close once settled
+// sweep the open fingers into a tall object come last: approach_clear()), grasp (at tight_peak_speed when the grasp is tight: tight_clearance), close once settled
 // (the arm's tip slower than settle_speed), carry (above the place pose, diagonal from the grasp;
 // "via": first straight up by lift_height, or until the object's bottom is 2 x held_clearance
 // above every other object and obstacle near its course: corridor_top), place (corrected for
@@ -77,6 +77,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "manisoft/control/arm_observation.hpp"
@@ -114,7 +115,8 @@ struct ExpertConfig {
   double slow_lower = 0.03;         ///< m: a lower line longer than twice this runs at the carry's speed until this far above its end (0: all slow)
   double approach_tip_clearance = 0.02;  ///< m: a tall object's approach keeps the open fingertips this far above its top until they straddle it
   double carry_settle_speed = 0.1;  ///< m/s: lower only once the arm's tip is slower at the end of the carry (0: at once)
-  double tight_clearance = 0.015;   ///< m: a grasp is tight when the open fingers clear the object by less on each side: descend to it at lower_peak_speed
+  double tight_clearance = 0.015;   ///< m: a grasp is tight when the open fingers clear the object by less on each side: descend to it at tight_peak_speed
+  double tight_peak_speed = 0.6;    ///< m/s: peak end-effector speed of the descent to a tight grasp
   double start_error = 0.03;       ///< m: a chained path starts once the previous one is this near
   double via_error = 0.05;          ///< m: the same at a leg's arc or via point (the next line starts from the shape target; the arm catches up)
   double table_clearance = 0.03;    ///< m: every rod node of a waypoint shape above the table top
@@ -127,6 +129,35 @@ struct ExpertConfig {
   double approach_distance = 0.06;  ///< m: the approach pose this far from the grasp, along the annotation's approach direction
   bool ramp_fallback = true;        ///< a refused line may be replaced by a shape ramp
   bool freeze_estimate_in_contact = true;  ///< the executor's stiffness estimate is frozen while the tool may touch things (descend, close, lower, open)
+
+  /// Refuses a value out of its range, naming the field (speeds and errors > 0, distances >= 0).
+  void validate() const {
+    using manisoft::detail::require_non_negative;
+    using manisoft::detail::require_positive;
+    for (const auto& [name, v] : {std::pair{"carry_height", carry_height}, {"lift_height", lift_height}, {"via_raise", via_raise},
+                                  {"place_clearance", place_clearance}, {"retract_height", retract_height},
+                                  {"finger_clearance", finger_clearance}, {"stack_finger_clearance", stack_finger_clearance},
+                                  {"carry_grip_share", carry_grip_share}, {"release_settle_speed", release_settle_speed},
+                                  {"release_lift", release_lift}, {"contact_depth", contact_depth}, {"slow_lower", slow_lower},
+                                  {"approach_tip_clearance", approach_tip_clearance}, {"carry_settle_speed", carry_settle_speed},
+                                  {"tight_clearance", tight_clearance}, {"table_clearance", table_clearance},
+                                  {"arm_clearance", arm_clearance}, {"held_clearance", held_clearance}, {"arc_inset", arc_inset}}) {
+      require_non_negative((std::string("ExpertConfig ") + name).c_str(), v);
+    }
+    for (const auto& [name, v] : {std::pair{"path_peak_speed", path_peak_speed}, {"max_node_speed", max_node_speed},
+                                  {"carry_peak_speed", carry_peak_speed}, {"carry_node_speed", carry_node_speed},
+                                  {"settle_speed", settle_speed}, {"settle_error", settle_error}, {"tall_ratio", tall_ratio},
+                                  {"retract_peak_speed", retract_peak_speed}, {"lower_peak_speed", lower_peak_speed},
+                                  {"tight_peak_speed", tight_peak_speed}, {"start_error", start_error}, {"via_error", via_error},
+                                  {"grasp_error", grasp_error}, {"approach_distance", approach_distance}}) {
+      require_positive((std::string("ExpertConfig ") + name).c_str(), v);
+    }
+    if (!(path_cruise >= 0 && path_cruise <= 0.95)) manisoft::detail::fail("ExpertConfig path_cruise = ", path_cruise, " is invalid: it must be in [0, 0.95]");
+    if (min_segment_steps < 1 || max_settle_steps < 0 || max_retries < 0) {
+      manisoft::detail::fail("ExpertConfig min_segment_steps = ", min_segment_steps, " (>= 1), max_settle_steps = ", max_settle_steps,
+                             " (>= 0), max_retries = ", max_retries, " (>= 0): out of range");
+    }
+  }
 };
 
 /// What the expert is doing.
@@ -165,6 +196,7 @@ class Expert {
   explicit Expert(const TaskEnv& env, ExpertConfig config = {})
       : env_(&env), config_(config), executor_(env.home_executor()), planner_(env.home_executor()), planner_backup_(env.home_executor()),
         arm_margin_(std::sqrt(env.arm_model().rod.cross_section_area.maxCoeff() / std::numbers::pi) + config.arm_clearance) {
+    config_.validate();
     const int n = env.arm_model().rod.n_elements;
     observation_ = control::make_arm_observation<double>(n, env.config().observe_stride);
     const auto& gp = env.gripper_parameters();
@@ -887,7 +919,7 @@ class Expert {
   }
 
   /// Whether the open fingers clear the object by less than tight_clearance on each side (a
-  /// plate, a bowl, a shoe): the arm then descends at lower_peak_speed, since its sideways sway
+  /// plate, a bowl, a shoe): the arm then descends at tight_peak_speed, since its sideways sway
   /// on a fast descent lands a finger on the object's rim and tips it.
   bool tight_grasp() const {
     return 0.5 * (env_->gripper_parameters().open_width - plan_.width) < config_.tight_clearance;
@@ -914,7 +946,7 @@ class Expert {
             start_leg(plan_.approach_leg, ++leg_);
           } else {
             enter(ExpertPhase::descend);
-            start_path(plan_.grasp, true, tight_grasp() ? config_.lower_peak_speed : 0.0);
+            start_path(plan_.grasp, true, tight_grasp() ? config_.tight_peak_speed : 0.0);
           }
         }
         break;
