@@ -24,9 +24,10 @@
 // on the object at its centre of mass x_o, the opposite force at x_o on the gripper and the
 // opposite torque (so the pair conserves momentum); x_a, R_a: the object's pose frozen in the
 // gripper frame at the grasp. The held object keeps colliding with everything (table, obstacles,
-// other objects, the rod, the palm) but the fingers while it is held (RigidWorld::
-// set_excluded_contact: the weld holds it, and the fingers, stopped within touch_tolerance of it,
-// would only add contacts to re-detect at every step of a carry). Closing on nothing closes the fingers to 0 and grasps
+// other objects, the rod) but the gripper itself while it is held (RigidWorld::
+// set_excluded_contact): the weld is the grip, up to its force limit, and the fingers stopped
+// within touch_tolerance of it (or a palm it touches) would only add contacts that fight the weld
+// and are re-detected at every step of a carry; once it slips or is released, they are found again. Closing on nothing closes the fingers to 0 and grasps
 // nothing (a closed gripper picks up nothing it bumps into later); S 1 -> 0 removes the weld at
 // once and the fingers open at the stroke speed. A real grip holds only up to its friction force:
 // when the spring force |k dx| exceeds max_hold_force (or |k_r dtheta| max_hold_torque) the object
@@ -298,11 +299,12 @@ class ParallelGripper {
     world.add_torque(body_, -m_.weld_torque);
   }
 
-  /// The weld holds the object: the fingers' contacts with it (they stopped within
-  /// touch_tolerance of it) are left out while it is held; the palm's stay.
+  /// The weld is the grip: the gripper's own contacts with what it holds (fingers stopped within
+  /// touch_tolerance of it, a palm it was pressed against) are left out while it is held.
   void exclude_held(rigid::RigidWorld& world) const {
     if (!m_.held) return world.set_excluded_contact(std::nullopt);
-    world.set_excluded_contact(rigid::RigidWorld::ExcludedContact{world.model(body_).first_geom + 1, 2, *m_.held});
+    const auto& m = world.model(body_);
+    world.set_excluded_contact(rigid::RigidWorld::ExcludedContact{m.first_geom, m.geom_count, *m_.held});
   }
 
   /// The finger geometries are the gripper compound's parts 1 (side -1) and 2 (side +1); each
