@@ -27,9 +27,10 @@
 // other objects, the rod) but the gripper itself while it is held (RigidWorld::
 // set_excluded_contact): the weld is the grip, up to its force limit, and the fingers stopped
 // within touch_tolerance of it (or a palm it touches) would only add contacts that fight the weld
-// and are re-detected at every step of a carry; once it slips or is released, they are found again. Closing on nothing closes the fingers to 0 and grasps
-// nothing (a closed gripper picks up nothing it bumps into later); S 1 -> 0 removes the weld at
-// once and the fingers open at the stroke speed. A real grip holds only up to its friction force:
+// and are re-detected at every step of a carry; once it slips or is released, they are found
+// again. Closing on nothing closes the fingers to 0 and grasps nothing (a closed gripper picks up
+// nothing it bumps into later); S 1 -> 0 removes the weld at once and the fingers open at the
+// stroke speed. A real grip holds only up to its friction force:
 // when the spring force |k dx| exceeds max_hold_force (or |k_r dtheta| max_hold_torque) the object
 // slips out and the grasp ends (reported by `slipped()`); the fingers then stay where they stopped
 // until opened. Opening is force-limited: while anything presses on a finger's outer face (the

@@ -500,8 +500,8 @@ class RigidWorld {
     std::uint32_t first_geom{0}, geom_count{0};  ///< geometries [first_geom, first_geom + geom_count) of one body
     BodyId body{0};                              ///< ... and every geometry of this (other) body
   };
-  /// Leaves out contact between some geometries of one body and another body (a gripper's
-  /// fingers and the object its weld holds) until cleared (nullopt) or replaced: their manifolds
+  /// Leaves out contact between some geometries of one body and another body (a gripper and
+  /// the object its weld holds) until cleared (nullopt) or replaced: their manifolds
   /// are kept empty, and re-detected from scratch once the exclusion ends. A setting, not state:
   /// whoever sets it sets it again after a restore (a manifold's memory says whether it was
   /// excluded, so a replay gives the same contacts).
