@@ -711,6 +711,15 @@ class RigidWorld {
     const double redetect = 0.5 * settings_.contact_margin;
     for (std::size_t i = 0; i < manifolds_.size(); ++i) {
       auto& m = manifolds_[i];
+      if (excluded(m)) {
+        if (m.count > 0 || !m.fresh) {
+          record_manifold(i);
+          m.count = 0;
+          m.patch = {};
+          m.fresh = true;  // re-detected once the exclusion ends
+        }
+        continue;
+      }
       const auto& sa = states_[m.body_a];
       const auto& sb = states_[m.body_b];
       // Analytic pairs with a rounded shape (sphere, capsule, cylinder: a cylinder on its cap
@@ -724,15 +733,6 @@ class RigidWorld {
       const auto ka = geoms_[m.geom_a].shape.kind, kb = geoms_[m.geom_b].shape.kind;
       const bool analytic_round = (is_round(ka) && (is_round(kb) || kb == contact::ShapeKind::box)) ||
                                   (is_round(kb) && ka == contact::ShapeKind::box);
-      if (excluded(m)) {
-        if (m.count > 0 || !m.fresh) {
-          record_manifold(i);
-          m.count = 0;
-          m.patch = {};
-          m.fresh = true;  // re-detected once the exclusion ends
-        }
-        continue;
-      }
       const bool moving = is_moving(m.body_a) || is_moving(m.body_b);
       if (!m.fresh && !((analytic_round || m.rolling) && moving) && (sa.travel - m.travel_a) + (sb.travel - m.travel_b) <= redetect) continue;
       record_manifold(i);
