@@ -161,13 +161,42 @@ int main(int argc, char** argv) {
     if (!quiet)
       std::printf("%s after %ld control steps (%.2f s simulated), episode CPU %.3f s\n", info.success ? "SUCCESS" : "FAILURE", info.step,
                   double(info.step) * env.control_dt(), episode_cpu);
+    if (!quiet && !info.success) {  // where everything ended: which part of the predicate failed
+      const auto snapshot = env.snapshot();
+      std::printf("at the end (gripper %s):\n", snapshot.gripper_open ? "open" : "closed");
+      for (std::size_t i = 0; i < snapshot.objects.size(); ++i) {
+        const auto& o = snapshot.objects[i];
+        std::printf("  object %zu %-14s centre of mass (%.3f, %.3f, %.3f), speed %.3f m/s, spin %.2f rad/s%s%s\n", i,
+                    spec.objects[i].asset_id.c_str(), o.center_of_mass.x(), o.center_of_mass.y(), o.center_of_mass.z(),
+                    o.linear_velocity.norm(), o.angular_velocity.norm(), o.held ? ", held" : "", o.touches_table ? ", on the table" : "");
+      }
+    }
+    const auto quoted = [](const std::string& text) {
+      std::string q = "\"";
+      for (const char ch : text) {
+        if (ch == '"' || ch == '\\') q += '\\';
+        q += ch;
+      }
+      return q + "\"";
+    };
     std::string failure = info.success ? "null" : "\"" + std::string(task::to_string(info.failure)) + "\"";
-    std::string why = expert.failure()[0] ? "\"" + std::string(expert.failure()) + "\"" : "null";
+    std::string why = expert.failure()[0] ? quoted(expert.failure()) : "null";
+    // What the episode was about, for per-category tables: the object moved (COLL, ALN: the goal's
+    // object; ARR: the first relation's) and ARR's first relation.
+    int moved = spec.goal.object;
+    std::string relation = "null";
+    if (!spec.goal.relations.empty()) {
+      const auto& r = spec.goal.relations.front();
+      if (!r.objects.empty()) moved = r.objects.front();
+      relation = quoted(std::string(manisoft::geometry::to_string(r.kind)));
+    }
+    const std::string object = moved >= 0 ? quoted(spec.objects[static_cast<std::size_t>(moved)].asset_id) : "null";
     std::printf("{\"task\":\"%s\",\"setting\":\"%s\",\"index\":%llu,\"seed\":%llu,\"success\":%s,\"success_at_end\":%s,\"steps\":%ld,\"failure\":%s,"
-                "\"expert\":%s,\"cpu_s\":%.3f,\"episode_cpu_s\":%.3f}\n",
+                "\"expert\":%s,\"cpu_s\":%.3f,\"episode_cpu_s\":%.3f,\"object\":%s,\"relation\":%s,\"instruction\":%s}\n",
                 std::string(scene::to_string(spec.task)).c_str(), std::string(scene::to_string(spec.setting)).c_str(),
                 static_cast<unsigned long long>(spec.index), static_cast<unsigned long long>(spec.seed), info.success ? "true" : "false",
-                env.success_at_end() ? "true" : "false", info.step, failure.c_str(), why.c_str(), cpu, episode_cpu);
+                env.success_at_end() ? "true" : "false", info.step, failure.c_str(), why.c_str(), cpu, episode_cpu, object.c_str(),
+                relation.c_str(), quoted(spec.instruction).c_str());
   } catch (const manisoft::Error& e) {
     std::fprintf(stderr, "run_task: %s\n", e.what());
     return 1;

@@ -410,10 +410,14 @@ TEST_CASE("the carry lifts the held object and the gripper over the container's 
     });
     return travel;
   };
-  manisoft::task::ExpertConfig unchecked;
+  // At the carry speed this scene was found with (1.2 m/s; at the default 1.5 the unchecked carry
+  // only nudges the basket 4 mm).
+  manisoft::task::ExpertConfig checked;
+  checked.carry_peak_speed = checked.carry_node_speed = 1.2;
+  manisoft::task::ExpertConfig unchecked = checked;
   unchecked.check_arm_clearance = false;
   CHECK(container_travel(unchecked) > 0.05);
-  const double travel = container_travel({});
+  const double travel = container_travel(checked);
   CAPTURE(manisoft::task::to_string(e.info().failure));
   CHECK(e.info().success);
   CHECK(travel < 0.005);
