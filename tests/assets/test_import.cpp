@@ -5,9 +5,9 @@
 #include <catch2/catch.hpp>
 
 #include "manisoft/assets/mesh_import.hpp"
+#include "../support/scratch_dir.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <unistd.h>
 
 #include <cstdint>
 #include <cstdlib>
@@ -26,14 +26,7 @@ using Vec3 = Eigen::Vector3d;
 
 namespace {
 
-fs::path temp_dir() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("manisoft_import_test_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
+fs::path temp_dir() { return manisoft::test::scratch_dir("manisoft_import_test"); }
 
 std::string write(const std::string& name, const std::string& bytes) {
   const fs::path p = temp_dir() / name;

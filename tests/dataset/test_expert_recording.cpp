@@ -10,6 +10,7 @@
 #include "manisoft/dataset/expert_recording.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/task/expert.hpp"
+#include "../support/scratch_dir.hpp"
 
 using namespace manisoft;
 
@@ -62,7 +63,7 @@ TEST_CASE("a recorded expert episode replays bit for bit, from memory and from i
 
   CHECK(dataset::replay_mismatch(env, e) == -1);
 
-  const auto path = std::filesystem::temp_directory_path() / "manisoft_test_recording.hdf5";
+  const auto path = manisoft::test::scratch_dir("manisoft_test_recording") / "episode.hdf5";
   dataset::write_episode(path, e);
   const dataset::Episode back = dataset::read_episode(path, 3);
   std::filesystem::remove(path);
