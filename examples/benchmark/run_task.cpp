@@ -12,11 +12,13 @@
 // object's pose (object<i>_px..._qz). --save-scene writes the scene JSON. Exit 0 whether or not
 // the episode succeeds; 1 on an error (a malformed scene file, no valid scene), 2 on bad flags.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <ctime>
 #include <fstream>
 #include <string>
+#include <string_view>
 
 #include "manisoft/scene/scene_json.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
@@ -171,15 +173,8 @@ int main(int argc, char** argv) {
                     o.linear_velocity.norm(), o.angular_velocity.norm(), o.held ? ", held" : "", o.touches_table ? ", on the table" : "");
       }
     }
-    const auto quoted = [](const std::string& text) {
-      std::string q = "\"";
-      for (const char ch : text) {
-        if (ch == '"' || ch == '\\') q += '\\';
-        q += ch;
-      }
-      return q + "\"";
-    };
-    std::string failure = info.success ? "null" : "\"" + std::string(task::to_string(info.failure)) + "\"";
+    const auto quoted = [](std::string_view text) { return nlohmann::json(text).dump(); };  // a JSON string, escaped
+    std::string failure = info.success ? "null" : quoted(task::to_string(info.failure));
     std::string why = expert.failure()[0] ? quoted(expert.failure()) : "null";
     // What the episode was about, for per-category tables: the object moved (COLL, ALN: the goal's
     // object; ARR: the first relation's) and ARR's first relation.
@@ -188,7 +183,7 @@ int main(int argc, char** argv) {
     if (!spec.goal.relations.empty()) {
       const auto& r = spec.goal.relations.front();
       if (!r.objects.empty()) moved = r.objects.front();
-      relation = quoted(std::string(manisoft::geometry::to_string(r.kind)));
+      relation = quoted(manisoft::geometry::to_string(r.kind));
     }
     const std::string object = moved >= 0 ? quoted(spec.objects[static_cast<std::size_t>(moved)].asset_id) : "null";
     std::printf("{\"task\":\"%s\",\"setting\":\"%s\",\"index\":%llu,\"seed\":%llu,\"success\":%s,\"success_at_end\":%s,\"steps\":%ld,\"failure\":%s,"
