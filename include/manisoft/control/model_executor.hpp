@@ -42,7 +42,10 @@
 //             straight distance (the blend's midpoint shape with its tip pulled onto the straight
 //             line and re-solved near it, recursively; the ramp then runs piecewise linearly
 //             through them, each segment's share of the time proportional to its largest node
-//             path); ramp_cruise replaces smoothstep by track_line's cruise timing.
+//             path); when they leave the blend's tip path longer than ramp_path_ratio x the straight
+//             distance, line vias instead (tips evenly on the straight line, rotation free,
+//             actuation relieved: try_line_vias); ramp_cruise replaces smoothstep by track_line's
+//             cruise timing.
 //   stiffness estimate (after the ramp, while every observed node is slower than
 //             estimate_speed_gate and no actuator saturates): a stiffness error s/s_hat bends the arm, to first order, to
 //             the curvature (s_hat/s) c* of the desired one. Every `outer_period` steps the
@@ -113,6 +116,7 @@ struct ModelExecutorSettings {
   Scalar ramp_max_node_step = std::numeric_limits<Scalar>::infinity();  ///< m per control step: planned peak speed of every node along the ramp (infinity: no bound)
   Scalar ramp_path_ratio = std::numeric_limits<Scalar>::infinity();  ///< a ramp segment whose tip path exceeds this x its straight distance gets a via shape (infinity: one blend)
   int ramp_via_depth = 4;                  ///< halvings of a ramp segment by via shapes, at most (up to 2^depth segments)
+  Scalar ramp_line_relief = Scalar(0.9);   ///< line vias (ramp_path_ratio): torque ratio above which a via's actuation is relieved
   Scalar ramp_cruise = Scalar(0);          ///< ramp timing: 0 smoothstep; in (0, 1) the cruise timing of track_line (lower peak speed for the same duration)
   Scalar outer_speed_gate = Scalar(0.15);  ///< m/s: integrate only while every observed node is slower
   Scalar outer_max_shift = Scalar(0.3);    ///< bound on |p_s - p*| (m) and |log(R_s R*^T)| (rad)
@@ -192,6 +196,7 @@ class ModelExecutor {
     if (!(settings_.ramp_max_node_step > 0)) manisoft::detail::fail("ModelExecutor ramp_max_node_step = ", settings_.ramp_max_node_step, " must be > 0");
     if (!(settings_.ramp_cruise >= Scalar(0) && settings_.ramp_cruise < Scalar(1))) manisoft::detail::fail("ModelExecutor ramp_cruise = ", settings_.ramp_cruise, " must be in [0, 1)");
     if (!(settings_.ramp_path_ratio >= Scalar(1))) manisoft::detail::fail("ModelExecutor ramp_path_ratio = ", settings_.ramp_path_ratio, " must be >= 1");
+    if (!(settings_.ramp_line_relief > Scalar(0) && settings_.ramp_line_relief <= Scalar(1))) manisoft::detail::fail("ModelExecutor ramp_line_relief = ", settings_.ramp_line_relief, " must be in (0, 1]");
     if (settings_.ramp_via_depth < 0 || settings_.ramp_via_depth > 4)
       manisoft::detail::fail("ModelExecutor ramp_via_depth = ", settings_.ramp_via_depth, " must be in [0, 4]");
     if (settings_.outer_period < 1) manisoft::detail::fail("ModelExecutor outer_period = ", settings_.outer_period, " must be >= 1");
@@ -446,6 +451,7 @@ class ModelExecutor {
     ramp_knot_count_ = 1;
     if (std::isfinite(settings_.ramp_path_ratio) && last_result_.within_limits && settings_.ramp_steps > 0) {
       add_ramp_segment(ramp_start_, ramp_end_, 0);
+      try_line_vias();
       statics_.set_coefficients(ramp_end_);
     } else {
       ramp_knots_[ramp_knot_count_++] = ramp_end_;
@@ -807,6 +813,38 @@ class ModelExecutor {
     ramp_knots_[static_cast<std::size_t>(ramp_knot_count_++)] = b;
   }
 
+  /// When the halving vias leave the ramp's tip path longer than ramp_path_ratio x the straight
+  /// distance (a large rotation about the tool axis curls the arm out of its plane, and the
+  /// pose-solved vias wander with it), the ramp runs instead through max_ramp_knots - 2 line
+  /// vias: shapes whose tips lie evenly spaced on the straight line, each the one before moved by
+  /// an even share of what remains of the coefficient change to the end shape and put on the line
+  /// with the tip rotation left free (InverseStatics::solve_position_near), its actuation relieved
+  /// below ramp_line_relief of the limits (a relieved via's drift is so spread over the vias
+  /// after it, not left to the last blend). Kept when every via converged within the limits and
+  /// the ramp's tip path got shorter.
+  void try_line_vias() {
+    Scalar path = 0;
+    for (int i = 1; i < ramp_knot_count_; ++i) path += blend_tip_path(ramp_knots_[static_cast<std::size_t>(i - 1)], ramp_knots_[static_cast<std::size_t>(i)], 8);
+    const Vector3 pa = statics_.tip_pose(ramp_start_).translation, pb = statics_.tip_pose(ramp_end_).translation;
+    if (!(path > settings_.ramp_path_ratio * (pb - pa).norm() + Scalar(1e-3))) return;
+    constexpr int vias = max_ramp_knots - 2;
+    line_knots_[0] = ramp_start_;
+    Scalar line_path = 0;
+    for (std::size_t i = 1; i <= static_cast<std::size_t>(vias); ++i) {
+      const Vector3 on_line = pa + (Scalar(i) / Scalar(vias + 1)) * (pb - pa);
+      const Coefficients start = line_knots_[i - 1] + (ramp_end_ - line_knots_[i - 1]) / Scalar(vias + 2 - static_cast<int>(i));
+      const auto r = statics_.solve_position_near(on_line, start, settings_.ramp_line_relief, line_relief_iterations);
+      if (!r.within_limits) return;
+      line_knots_[i] = statics_.coefficients();
+      line_path += blend_tip_path(line_knots_[i - 1], line_knots_[i], 4);
+    }
+    line_knots_[vias + 1] = ramp_end_;
+    line_path += blend_tip_path(line_knots_[vias], ramp_end_, 4);
+    if (!(line_path < path)) return;
+    ramp_knots_ = line_knots_;
+    ramp_knot_count_ = max_ramp_knots;
+  }
+
   /// The largest node displacement along the blend from shape a to b, summed over 4 samples.
   Scalar blend_node_path(const Coefficients& a, const Coefficients& b) {
     constexpr int samples = 4;
@@ -886,9 +924,11 @@ class ModelExecutor {
   int ramp_steps_ = 0;
   Scalar ramp_path_ = 0;
   std::array<Array3, 2> ramp_nodes_;  ///< node positions of successive ramp samples (set_target)
+  static constexpr int line_relief_iterations = 30;  // try_line_vias: relief steps per via, at most
   static constexpr int max_ramp_knots = 17;  // 2^ramp_via_depth + 1, depth at most 4
   std::array<Coefficients, max_ramp_knots> ramp_knots_{};  // the ramp's shapes (start, vias, end)
   std::array<Scalar, max_ramp_knots> ramp_knot_s_{};       // their blend parameters in [0, 1]
+  std::array<Coefficients, max_ramp_knots> line_knots_{};  // try_line_vias' candidate ramp
   int ramp_knot_count_ = 2;
   long steps_ = 0;
   Array3 positions_, velocities_;

@@ -332,7 +332,70 @@ class InverseStatics {
     return make_result(r, it, 0);
   }
 
+  /// Solves for a tip position only, the tip rotation left free, near the shape `start`:
+  /// minimum-effort-norm Gauss-Newton steps on the 3 position residuals (at most
+  /// `max_iterations`), then, while the largest torque ratio exceeds `relief_ratio`, up to
+  /// `relief_iterations` relief steps along the shapes with the same tip position (as
+  /// solve_near's, in the 6-dimensional null space of the position Jacobian). For shapes
+  /// between two poses whose tips should stay on a line (the model executor's line vias). The
+  /// result (rotation_error 0) becomes the committed solution. Does not allocate.
+  InverseStaticsResult<Scalar> solve_position_near(const Vector3& position, const Coefficients& start, Scalar relief_ratio,
+                                                   int relief_iterations, int max_iterations = 12) {
+    if (!position.allFinite()) manisoft::detail::fail("InverseStatics: the target position is not finite");
+    if (!start.allFinite()) manisoft::detail::fail("InverseStatics: the start coefficients are not finite");
+    Coefficients c = start;
+    Vector3 r = position_residual(c, position);
+    int it = position_newton(position, c, r, max_iterations);
+    if (r.norm() < settings_.accept_error)
+      it += relieve_along<3>(c, relief_ratio, relief_iterations, [&](const Coefficients& at) { return position_jacobian(at); },
+                             [&](Coefficients& trial, int& newton_iterations) {
+                               Vector3 r_trial = position_residual(trial, position);
+                               newton_iterations += position_newton(position, trial, r_trial, 4);
+                               return r_trial.norm() < settings_.accept_error;
+                             });
+    r = position_residual(c, position);
+    shape(c);
+    coefficients_ = c;
+    commit();
+    Residual full = Residual::Zero();
+    full.template head<3>() = r;
+    return make_result(full, it, 0);
+  }
+
  private:
+  Vector3 position_residual(const Coefficients& c, const Vector3& position) {
+    shape(c);
+    return tip_ - position;
+  }
+
+  /// The position rows of the analytic Jacobian (jacobian() with the rotation residual zero).
+  Eigen::Matrix<Scalar, 3, n_coefficients> position_jacobian(const Coefficients& c) {
+    shape(c);
+    const Pose here{directors_[n_elements() - 1].transpose(), tip_};
+    jacobian(c, Residual::Zero(), here);
+    return jacobian_.template topRows<3>();
+  }
+
+  /// newton() on the tip position alone (minimum-W-norm steps, halved while they do not help).
+  int position_newton(const Vector3& position, Coefficients& c, Vector3& r, int max_iterations) {
+    int p = 0;
+    for (; p < max_iterations && r.norm() > settings_.tolerance; ++p) {
+      const Eigen::Matrix<Scalar, 3, n_coefficients> j = position_jacobian(c);
+      const Eigen::Matrix<Scalar, n_coefficients, 3> wj = regularizer_inverse_ * j.transpose();
+      const Coefficients step = wj * (j * wj).ldlt().solve(r);
+      Coefficients trial = c - step;
+      Vector3 r_trial = position_residual(trial, position);
+      for (int half = 0; half < 4 && !(r_trial.norm() < r.norm()); ++half) {
+        trial = c - std::ldexp(Scalar(1), -(half + 1)) * step;
+        r_trial = position_residual(trial, position);
+      }
+      if (!(r_trial.norm() < r.norm())) break;
+      c = trial;
+      r = r_trial;
+    }
+    return p;
+  }
+
   InverseStaticsResult<Scalar> solve_impl(const Pose& target, const Coefficients& start, int max_iterations) {
     require_finite_target(target);
     if (!start.allFinite()) manisoft::detail::fail("InverseStatics: the start coefficients are not finite");
@@ -437,45 +500,62 @@ class InverseStatics {
   /// step). A step is kept only if it meets the target and lowers E. Returns the Newton
   /// iterations used.
   int relieve(const Pose& target, Coefficients& c, Residual& r) {
+    const int used = relieve_along<6>(c, settings_.relief_threshold, settings_.relief_iterations,
+                                      [&](const Coefficients& at) -> Jacobian {
+                                        jacobian(at, r, target);
+                                        return jacobian_;
+                                      },
+                                      [&](Coefficients& trial, int& newton_iterations) {
+                                        Residual r_trial = residual(trial, target);
+                                        newton_iterations += newton(target, trial, r_trial, 4);
+                                        return r_trial.norm() < settings_.accept_error;
+                                      });
+    r = residual(c, target);
+    return used;
+  }
+
+  /// relieve() along the shapes that keep `Rows` constraints (the tip pose: 6, the tip position:
+  /// 3): jacobian_of(c) gives their Jacobian, restore(trial, used) returns a trial step to them
+  /// (adding its Newton iterations to `used`) and says whether it met them. Returns `used`.
+  template <int Rows, typename JacobianOf, typename Restore>
+  int relieve_along(Coefficients& c, Scalar threshold, int iterations, JacobianOf jacobian_of, Restore restore) {
     int used = 0;
     Scalar ratio = 0;
     Scalar e0 = effort(c, ratio);
-    for (int step = 0; step < settings_.relief_iterations; ++step) {
-      if (!(ratio > settings_.relief_threshold)) break;
+    for (int step = 0; step < iterations; ++step) {
+      if (!(ratio > threshold)) break;
       // The W-projected descent -(I - W^-1 J^T (J W^-1 J^T)^-1 J) W^-1 grad E equals -N N^T grad E
       // for a W-orthonormal basis N of the null space of J (N^T W N = I, J N = 0): with W = L L^T,
       // N = L^-T Y, Y an orthonormal basis of the null space of J L^-T (the last columns of a QR
-      // of its transpose). So E is differentiated along the 3 columns of N only (forward
+      // of its transpose). So E is differentiated along the columns of N only (forward
       // differences), not along all 9 coefficients.
-      jacobian(c, r, target);
-      const Eigen::Matrix<Scalar, n_coefficients, 6> a_t = (jacobian_ * regularizer_factor_inverse_t_).transpose();
-      const Eigen::ColPivHouseholderQR<Eigen::Matrix<Scalar, n_coefficients, 6>> qr(a_t);
+      const Eigen::Matrix<Scalar, Rows, n_coefficients> j = jacobian_of(c);
+      const Eigen::Matrix<Scalar, n_coefficients, Rows> a_t = (j * regularizer_factor_inverse_t_).transpose();
+      const Eigen::ColPivHouseholderQR<Eigen::Matrix<Scalar, n_coefficients, Rows>> qr(a_t);
       const Matrix9 q = qr.householderQ();
-      constexpr int n_free = n_coefficients - 6;
+      constexpr int n_free = n_coefficients - Rows;
       const Eigen::Matrix<Scalar, n_coefficients, n_free> basis = regularizer_factor_inverse_t_ * q.template rightCols<n_free>();
       const Scalar c_scale = Scalar(1) + c.template lpNorm<Eigen::Infinity>();
       Eigen::Matrix<Scalar, n_free, 1> slope;
-      for (int j = 0; j < n_free; ++j) {
-        const Scalar h = Scalar(1e-6) * c_scale / basis.col(j).template lpNorm<Eigen::Infinity>();
+      for (int k = 0; k < n_free; ++k) {
+        const Scalar h = Scalar(1e-6) * c_scale / basis.col(k).template lpNorm<Eigen::Infinity>();
         Scalar unused = 0;
-        slope[j] = (effort(c + h * basis.col(j), unused) - e0) / h;
+        slope[k] = (effort(c + h * basis.col(k), unused) - e0) / h;
       }
       const Coefficients d = -(basis * slope);  // W-projected descent
       const Scalar d_norm = d.norm();
       if (!(d_norm > Scalar(0))) break;
-      const Scalar strength = std::min(Scalar(1), (ratio - settings_.relief_threshold) / (Scalar(1) - settings_.relief_threshold));
+      const Scalar strength = std::min(Scalar(1), (ratio - threshold) / (Scalar(1) - threshold));
       const Scalar length = settings_.relief_step * strength;
       bool kept = false;
       for (int half = 0; half < 4 && !kept; ++half) {
         Coefficients trial = c + std::ldexp(length / d_norm, -half) * d;
-        Residual r_trial = residual(trial, target);
-        used += newton(target, trial, r_trial, 4);
-        if (!(r_trial.norm() < settings_.accept_error)) continue;
+        Coefficients restored = trial;
+        if (!restore(restored, used)) continue;
         Scalar trial_ratio = 0;
-        const Scalar e_trial = effort(trial, trial_ratio);
+        const Scalar e_trial = effort(restored, trial_ratio);
         if (e_trial < e0) {
-          c = trial;
-          r = r_trial;
+          c = restored;
           e0 = e_trial;
           ratio = trial_ratio;
           kept = true;
