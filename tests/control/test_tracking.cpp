@@ -151,6 +151,8 @@ TEST_CASE("solve_position_near meets a tip position with the rotation free and r
   CHECK((statics.tip_pose(statics.coefficients()).translation - goal).norm() < 1e-9);
   CHECK(relieved.max_torque_ratio < 0.9 * plain.max_torque_ratio);
   CHECK_THROWS_WITH(statics.solve_position_near(Eigen::Vector3d(0.6, std::nan(""), 0.9), start, 1.0, 0), Catch::Contains("not finite"));
+  CHECK_THROWS_WITH(statics.solve_position_near(goal, start, 1.5, 0), Catch::Contains("relief_ratio = 1.5"));
+  CHECK_THROWS_WITH(statics.solve_position_near(goal, start, 0.9, -1), Catch::Contains("relief_iterations = -1"));
 }
 
 TEST_CASE("a path the arm cannot hold is refused and leaves the executor as it was", "[executor][tracking]") {

@@ -343,6 +343,9 @@ class InverseStatics {
                                                    int relief_iterations, int max_iterations = 12) {
     if (!position.allFinite()) manisoft::detail::fail("InverseStatics: the target position is not finite");
     if (!start.allFinite()) manisoft::detail::fail("InverseStatics: the start coefficients are not finite");
+    if (!(relief_ratio > 0 && relief_ratio <= 1)) manisoft::detail::fail("InverseStatics: relief_ratio = ", relief_ratio, " must be in (0, 1]");
+    if (relief_iterations < 0 || max_iterations < 0)
+      manisoft::detail::fail("InverseStatics: relief_iterations = ", relief_iterations, " and max_iterations = ", max_iterations, " must be >= 0");
     Coefficients c = start;
     Vector3 r = position_residual(c, position);
     int it = position_newton(position, c, r, max_iterations);
