@@ -450,8 +450,9 @@ class ModelExecutor {
     ramp_knots_[0] = ramp_start_;
     ramp_knot_count_ = 1;
     if (std::isfinite(settings_.ramp_path_ratio) && last_result_.within_limits && settings_.ramp_steps > 0) {
-      add_ramp_segment(ramp_start_, ramp_end_, 0);
-      try_line_vias();
+      Scalar path = 0;
+      add_ramp_segment(ramp_start_, ramp_end_, 0, path);
+      try_line_vias(path);
       statics_.set_coefficients(ramp_end_);
     } else {
       ramp_knots_[ramp_knot_count_++] = ramp_end_;
@@ -788,11 +789,11 @@ class ModelExecutor {
   /// blend's midpoint shape, its tip moved to the straight line's midpoint (or 0.8, 0.6, 0.45,
   /// 0.3, 0.15 of the way there) and re-solved near it (solve_near, else solve_from), kept when within the
   /// limits and the two blends through it are shorter; each half is checked again, at most
-  /// ramp_via_depth halvings deep.
-  void add_ramp_segment(const Coefficients& a, const Coefficients& b, int depth) {
+  /// ramp_via_depth halvings deep. Adds the tip path of each blend it appends to `ramp_path`.
+  void add_ramp_segment(const Coefficients& a, const Coefficients& b, int depth, Scalar& ramp_path) {
+    const Scalar path = blend_tip_path(a, b, 8);
     if (depth < settings_.ramp_via_depth) {
       const Vector3 pa = statics_.tip_pose(a).translation, pb = statics_.tip_pose(b).translation;
-      const Scalar path = blend_tip_path(a, b, 8);
       if (path > settings_.ramp_path_ratio * (pb - pa).norm() + Scalar(1e-3)) {
         const Coefficients mid = Scalar(0.5) * (a + b);
         const Pose blend_mid = statics_.tip_pose(mid);
@@ -803,14 +804,15 @@ class ModelExecutor {
           if (!r.within_limits) continue;
           const Coefficients v = statics_.coefficients();
           if (blend_tip_path(a, v, 8) + blend_tip_path(v, b, 8) < Scalar(0.98) * path) {
-            add_ramp_segment(a, v, depth + 1);
-            add_ramp_segment(v, b, depth + 1);
+            add_ramp_segment(a, v, depth + 1, ramp_path);
+            add_ramp_segment(v, b, depth + 1, ramp_path);
             return;
           }
         }
       }
     }
     ramp_knots_[static_cast<std::size_t>(ramp_knot_count_++)] = b;
+    ramp_path += path;
   }
 
   /// When the halving vias leave the ramp's tip path longer than ramp_path_ratio x the straight
@@ -822,9 +824,8 @@ class ModelExecutor {
   /// below ramp_line_relief of the limits (a relieved via's drift is so spread over the vias
   /// after it, not left to the last blend). Kept when every via converged within the limits and
   /// the ramp's tip path got shorter.
-  void try_line_vias() {
-    Scalar path = 0;
-    for (int i = 1; i < ramp_knot_count_; ++i) path += blend_tip_path(ramp_knots_[static_cast<std::size_t>(i - 1)], ramp_knots_[static_cast<std::size_t>(i)], 8);
+  /// `path`: the tip path of the ramp's blends (add_ramp_segment's sum).
+  void try_line_vias(Scalar path) {
     const Vector3 pa = statics_.tip_pose(ramp_start_).translation, pb = statics_.tip_pose(ramp_end_).translation;
     if (!(path > settings_.ramp_path_ratio * (pb - pa).norm() + Scalar(1e-3))) return;
     constexpr int vias = max_ramp_knots - 2;

@@ -356,8 +356,7 @@ class InverseStatics {
                                newton_iterations += position_newton(position, trial, r_trial, 4);
                                return r_trial.norm() < settings_.accept_error;
                              });
-    r = position_residual(c, position);
-    shape(c);
+    r = position_residual(c, position);  // (leaves c's shape in the buffers for commit())
     coefficients_ = c;
     commit();
     Residual full = Residual::Zero();
@@ -377,26 +376,6 @@ class InverseStatics {
     const Pose here{directors_[n_elements() - 1].transpose(), tip_};
     jacobian(c, Residual::Zero(), here);
     return jacobian_.template topRows<3>();
-  }
-
-  /// newton() on the tip position alone (minimum-W-norm steps, halved while they do not help).
-  int position_newton(const Vector3& position, Coefficients& c, Vector3& r, int max_iterations) {
-    int p = 0;
-    for (; p < max_iterations && r.norm() > settings_.tolerance; ++p) {
-      const Eigen::Matrix<Scalar, 3, n_coefficients> j = position_jacobian(c);
-      const Eigen::Matrix<Scalar, n_coefficients, 3> wj = regularizer_inverse_ * j.transpose();
-      const Coefficients step = wj * (j * wj).ldlt().solve(r);
-      Coefficients trial = c - step;
-      Vector3 r_trial = position_residual(trial, position);
-      for (int half = 0; half < 4 && !(r_trial.norm() < r.norm()); ++half) {
-        trial = c - std::ldexp(Scalar(1), -(half + 1)) * step;
-        r_trial = position_residual(trial, position);
-      }
-      if (!(r_trial.norm() < r.norm())) break;
-      c = trial;
-      r = r_trial;
-    }
-    return p;
   }
 
   InverseStaticsResult<Scalar> solve_impl(const Pose& target, const Coefficients& start, int max_iterations) {
@@ -586,18 +565,38 @@ class InverseStatics {
   /// Stage 3: final Newton steps (minimum-W-norm step) so the shape meets the target to
   /// round-off; returns its iterations.
   int newton(const Pose& target, Coefficients& c, Residual& r, int max_iterations, bool halving = false) {
+    return min_norm_newton<6>(c, r, max_iterations, halving,
+                              [&](const Coefficients& at) -> const Jacobian& {
+                                jacobian(at, r, target);
+                                return jacobian_;
+                              },
+                              [&](const Coefficients& at) { return residual(at, target); });
+  }
+
+  /// newton() on the tip position alone, halving its steps (the line vias start away from the line).
+  int position_newton(const Vector3& position, Coefficients& c, Vector3& r, int max_iterations) {
+    return min_norm_newton<3>(c, r, max_iterations, true, [&](const Coefficients& at) { return position_jacobian(at); },
+                              [&](const Coefficients& at) { return position_residual(at, position); });
+  }
+
+  /// Gauss-Newton on `Rows` residuals (residual_of(c), Jacobian jacobian_of(c)) by minimum-W-norm
+  /// steps; with `halving`, a step that does not lower |r| is halved up to 4 times (far from the
+  /// solution a full step can overshoot). Stops below `tolerance` or when a step does not help;
+  /// returns its iterations.
+  template <int Rows, typename JacobianOf, typename ResidualOf>
+  int min_norm_newton(Coefficients& c, Eigen::Matrix<Scalar, Rows, 1>& r, int max_iterations, bool halving, JacobianOf jacobian_of,
+                      ResidualOf residual_of) {
     int p = 0;
     for (; p < max_iterations && r.norm() > settings_.tolerance; ++p) {
-      jacobian(c, r, target);
-      const Eigen::Matrix<Scalar, n_coefficients, 6> wj = regularizer_inverse_ * jacobian_.transpose();
-      const Eigen::Matrix<Scalar, 6, 6> m = jacobian_ * wj;
+      const Eigen::Matrix<Scalar, Rows, n_coefficients> j = jacobian_of(c);
+      const Eigen::Matrix<Scalar, n_coefficients, Rows> wj = regularizer_inverse_ * j.transpose();
+      const Eigen::Matrix<Scalar, Rows, Rows> m = j * wj;
       const Coefficients step = wj * m.ldlt().solve(r);
       Coefficients trial = c - step;
-      Residual r_trial = residual(trial, target);
-      // Far from the solution a full step can overshoot: halve it while it does not help.
+      Eigen::Matrix<Scalar, Rows, 1> r_trial = residual_of(trial);
       for (int half = 0; halving && half < 4 && !(r_trial.norm() < r.norm()); ++half) {
         trial = c - std::ldexp(Scalar(1), -(half + 1)) * step;
-        r_trial = residual(trial, target);
+        r_trial = residual_of(trial);
       }
       if (!(r_trial.norm() < r.norm())) break;
       c = trial;
