@@ -3,7 +3,8 @@
 #   1. g++, Release at -O1 (a heavy translation unit compiles in about 2/3 of the time it takes at
 #      -O2, and faster than at -O0; BENCHMARKS.md numbers come from a default -O3 build), -Wall
 #      -Wextra -Wpedantic -Werror. The examples no test runs and the benchmarks are only checked
-#      for warnings (MANISOFT_CHECK_ONLY: -fsyntax-only, not built).
+#      for warnings (MANISOFT_CHECK_ONLY: -fsyntax-only, not built; all of them in one translation
+#      unit, manisoft_add_unrun_check in CMakeLists.txt).
 #   2. clang++ with AddressSanitizer + UndefinedBehaviorSanitizer (-O1, line tables only: stack
 #      traces name file and line, and the build is faster than with full -g): the tests and the
 #      examples they run; the other examples and the per-header check (every header compiled on
