@@ -3,10 +3,17 @@
 // per variant: no shadows, shadows (1024^2 map, or 512^2), shadows + depth + id read back, 4x MSAA,
 // a spot light (perspective shadow map over its cone); and the set-up cost (EGL display + context +
 // shaders + scene upload). Wall time is the reported time (UseRealTime); CPU time is the calling
-// thread's only (llvmpipe's raster threads are not counted). Every frame is drawn from scratch.
+// thread's only (llvmpipe's raster threads are not counted). BM_Frame_*: every frame is drawn from
+// scratch (GlRendererOptions::incremental off). BM_Episode_*: the frames of an episode, drawn
+// incrementally (the default): the arm sways and bends (tip about 7 mm a frame), the gripper follows
+// it carrying the cube, the other objects rest; counters: the mean share of the image and of the
+// shadow map's window redrawn, and how many frames were drawn whole.
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <cstdlib>
+#include <numbers>
+#include <vector>
 
 #include "manisoft/render/gl_renderer.hpp"
 #include "tabletop_render_scene.hpp"
@@ -28,6 +35,7 @@ void run_frames(benchmark::State& state, bool shadows, bool readback, int msaa, 
   options.read_depth = readback;
   options.read_mask = readback;
   options.msaa_samples = msaa;
+  options.incremental = false;
   GlRenderer gl(options);
   tabletop::TabletopScene t = tabletop::make_tabletop_scene();
   if (!textures) {
@@ -51,6 +59,62 @@ void run_frames(benchmark::State& state, bool shadows, bool readback, int msaa, 
   state.counters["triangles"] = static_cast<double>(triangles + make_tube(frame.rod.nodes, frame.rod.directors, 0.05).triangle_count());
   state.SetLabel(gl.device_name());
 }
+
+// One 300-frame cycle of a swaying arm: roll -20 +- 25 degrees (period 300 frames), bend 85 +- 10
+// degrees (period 150).
+std::vector<FrameState> episode(const tabletop::TabletopScene& t) {
+  const double pi = std::numbers::pi;
+  std::vector<FrameState> frames;
+  for (int k = 0; k < 300; ++k) {
+    FrameState f = t.frame;
+    const double bend = (85.0 + 10.0 * std::sin(2 * pi * k / 150.0)) * pi / 180.0;
+    const double roll = (-20.0 + 25.0 * std::sin(2 * pi * k / 300.0)) * pi / 180.0;
+    f.rod = tabletop::arc_rod(Eigen::Vector3d(-0.05, 0, 1.5), 1.0, 20, bend, 0.05, roll);
+    const manisoft::math::Pose<double> gripper = tabletop::gripper_at_tip(f.rod);
+    tabletop::set_gripper(t, f, gripper, 0.06);
+    f.instance_poses[t.object_instance.at("cube")] = gripper * tabletop::at(0, 0, 0.1);
+    f.goal_pose = tabletop::at(0.3, 0.15, 0.9);
+    frames.push_back(std::move(f));
+  }
+  return frames;
+}
+
+void run_episode(benchmark::State& state, bool shadows, bool readback) {
+  set_shader_cache();
+  GlRendererOptions options;
+  options.shadows = shadows;
+  options.read_depth = readback;
+  options.read_mask = readback;
+  GlRenderer gl(options);
+  const tabletop::TabletopScene t = tabletop::make_tabletop_scene();
+  gl.set_scene(t.scene);
+  const std::vector<FrameState> frames = episode(t);
+  RenderOutput out;
+  gl.render_into(frames.back(), out);  // warm-up: first-frame shader variants, drawn whole
+  double window = static_cast<double>(gl.last_draw().shadow_texels);
+  std::size_t k = 0, whole = 0;
+  double pixels = 0, texels = 0;
+  for (auto _ : state) {
+    gl.render_into(frames[k++ % frames.size()], out);
+    benchmark::DoNotOptimize(out.rgb.data());
+    const GlRenderer::DrawStats& drawn = gl.last_draw();
+    if (drawn.everything) {
+      ++whole;
+      window = static_cast<double>(drawn.shadow_texels);
+    }
+    pixels += static_cast<double>(drawn.pixels);
+    texels += static_cast<double>(drawn.shadow_texels);
+  }
+  const double frames_drawn = static_cast<double>(k);
+  state.counters["image_redrawn"] = pixels / frames_drawn / static_cast<double>(out.width * out.height);
+  if (shadows && window > 0) state.counters["shadow_redrawn"] = texels / frames_drawn / window;
+  state.counters["whole_frames"] = static_cast<double>(whole);
+  state.SetLabel(gl.device_name());
+}
+
+void BM_Episode_NoShadows(benchmark::State& s) { run_episode(s, false, false); }
+void BM_Episode_NoShadows_DepthIds(benchmark::State& s) { run_episode(s, false, true); }
+void BM_Episode_Shadows_DepthIds(benchmark::State& s) { run_episode(s, true, true); }
 
 void BM_Frame_NoShadows(benchmark::State& s) { run_frames(s, false, false, 0); }
 void BM_Frame_NoShadows_NoTextures(benchmark::State& s) { run_frames(s, false, false, 0, false); }
@@ -81,6 +145,9 @@ BENCHMARK(BM_Frame_Shadows_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime
 BENCHMARK(BM_Frame_Shadows512_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_Frame_SpotLight_Shadows_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_Frame_MSAA4_Shadows_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_Episode_NoShadows)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_Episode_NoShadows_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_Episode_Shadows_DepthIds)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(BM_SetUp)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
 
 BENCHMARK_MAIN();

@@ -360,3 +360,82 @@ TEST_CASE("PNG files round-trip and are written atomically", "[render]") {
   CHECK(depth_millimetres({0.0f, 1.2344f, 70.0f}) == std::vector<std::uint16_t>{0, 1234, 65535});
   std::filesystem::remove_all(dir);
 }
+
+namespace {
+
+// Frame k of a short episode in the built-in scene: the arm sways and bends, the gripper follows
+// its tip carrying the cube, the goal marker comes and goes, the ball is knocked once; frames 9
+// and 10 are the same.
+FrameState episode_frame(const tabletop::TabletopScene& t, int k) {
+  const double pi = std::numbers::pi;
+  const int s = k == 10 ? 9 : k;
+  FrameState f = t.frame;
+  f.rod = tabletop::arc_rod(Eigen::Vector3d(-0.05, 0, 1.5), 1.0, 20, (85.0 + 2.0 * s) * pi / 180.0, 0.05, (-20.0 + 3.0 * s) * pi / 180.0);
+  const manisoft::math::Pose<double> gripper = tabletop::gripper_at_tip(f.rod);
+  tabletop::set_gripper(t, f, gripper, 0.06);
+  f.instance_poses[t.object_instance.at("cube")] = gripper * tabletop::at(0, 0, 0.1);
+  if (s >= 12) f.instance_poses[t.object_instance.at("ball")] = tabletop::at(0.50, -0.20, 0.785);
+  if (s % 8 < 5) f.goal_pose = tabletop::at(0.3, 0.15, 0.9 + 0.01 * s);
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("incremental frames are the full redraws, pixel for pixel, and redraw less", "[render]") {
+  tabletop::TabletopScene t = tabletop::make_tabletop_scene();
+  Camera side = t.scene.cameras.front();
+  side.position = {1.6, -1.2, 1.4};
+  t.scene.cameras.push_back(side);
+  struct Case {
+    const char* name;
+    bool shadows;
+    int msaa;
+    LightKind light;
+  };
+  for (const Case& c : {Case{"shadows", true, 0, LightKind::directional}, Case{"no shadows", false, 0, LightKind::directional},
+                        Case{"4x MSAA", true, 4, LightKind::directional}, Case{"spot light", true, 0, LightKind::spot}}) {
+    INFO(c.name);
+    SceneDescription scene = t.scene;
+    scene.lighting.kind = c.light;
+    GlRendererOptions full_options;
+    full_options.shadows = c.shadows;
+    full_options.msaa_samples = c.msaa;
+    full_options.incremental = false;
+    GlRendererOptions incremental_options = full_options;
+    incremental_options.incremental = true;
+    GlRenderer full(full_options), incremental(incremental_options);
+    full.set_scene(scene);
+    incremental.set_scene(scene);
+    const std::size_t pixels = static_cast<std::size_t>(scene.cameras[0].width) * static_cast<std::size_t>(scene.cameras[0].height);
+    RenderOutput a, b;
+    int partial = 0;
+    for (int k = 0; k < 18; ++k) {
+      INFO("frame " << k);
+      const std::size_t camera = k == 15 ? 1 : 0;  // one frame from the other camera
+      const FrameState frame = episode_frame(t, k);
+      full.render_into(frame, a, camera);
+      incremental.render_into(frame, b, camera);
+      CHECK(a.rgb == b.rgb);
+      CHECK(a.depth == b.depth);
+      CHECK(a.mask == b.mask);
+      const GlRenderer::DrawStats& drawn = incremental.last_draw();
+      CHECK(full.last_draw().everything);
+      if (k == 0 || k == 15 || k == 16 || c.light == LightKind::spot) {
+        CHECK(drawn.everything);  // first frame, camera changes, spot light
+        CHECK(drawn.pixels == pixels);
+      } else if (k == 10) {
+        CHECK_FALSE(drawn.everything);  // nothing moved
+        CHECK(drawn.rectangles == 0);
+        CHECK(drawn.shadow_texels == 0);
+      } else if (!drawn.everything) {  // the shadow map's window may grow or shrink with the arm
+        CHECK(drawn.rectangles > 0);
+        CHECK(drawn.pixels < pixels / 2);
+      }
+      partial += drawn.everything ? 0 : 1;
+    }
+    if (c.light == LightKind::directional) CHECK(partial >= 12);  // of the 15 frames that may be drawn in part
+    incremental.set_scene(scene);
+    incremental.render_into(episode_frame(t, 17), b);
+    CHECK(incremental.last_draw().everything);  // a new scene draws everything
+  }
+}

@@ -17,7 +17,13 @@
 // the same pixels); opaque meshes are drawn small before large, receivers last (early depth test);
 // the image is rendered upside down so that glReadPixels returns rows top first (no flipping
 // copies), and colour is read as RGBA (llvmpipe's copy path); the id target is drawn only when the
-// mask is read; glibc's heap trimming is relaxed (GlRendererOptions::keep_freed_heap).
+// mask is read; glibc's heap trimming is relaxed (GlRendererOptions::keep_freed_heap). Between
+// frames only what changed is redrawn (GlRendererOptions::incremental): rectangles around the
+// moved instances, tube chunks and goal marker (before and after), the shadow map's texels their
+// casters cover, and the pixels whose shadow lookup reads those texels (each drawable's box clipped
+// to the prism those texels sweep along the light) are cleared, then each drawable that reaches
+// them is drawn once under a scissor; the targets keep every other pixel, which a full redraw
+// would draw identically (there a redrawn fragment fails the depth test).
 #pragma once
 
 #include <GL/glcorearb.h>
@@ -29,8 +35,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 #if defined(__GLIBC__)  // defined by the standard headers above
@@ -63,6 +71,12 @@ struct GlRendererOptions {
   /// across CPUs; about 5% of a frame's CPU work on llvmpipe). The cost: up to 64 MiB of freed
   /// memory stays with the process.
   bool keep_freed_heap = true;
+  /// Redraw only what changed since the previous frame of the same camera: screen rectangles
+  /// around what moved (where it was and where it is) and, with a directional light, the part of
+  /// the shadow map its shadow covers and the pixels that read that part. The targets keep the
+  /// rest, so the image is the one a full redraw gives, pixel for pixel. Everything is drawn after
+  /// set_scene(), a change of camera or of the shadow map's window, and with a spot light.
+  bool incremental = true;
   EglOptions egl;
 };
 
@@ -450,7 +464,12 @@ class GlRenderer {
     for (std::size_t i = 0; i < scene.meshes.size(); ++i) detail_gl::upload(meshes_[i], scene.meshes[i], false, upload_scratch_);
     for (auto& g : triad_) detail_gl::destroy(g);
     const std::vector<Mesh> triad = make_axis_triad(scene.goal_marker.axis_length, scene.goal_marker.axis_width);
-    for (std::size_t i = 0; i < 3; ++i) detail_gl::upload(triad_[i], triad[i], false, upload_scratch_);
+    triad_bounds_.setEmpty();
+    for (std::size_t i = 0; i < 3; ++i) {
+      detail_gl::upload(triad_[i], triad[i], false, upload_scratch_);
+      for (const Eigen::Vector3f& p : triad[i].positions) triad_bounds_.extend(p);
+    }
+    drawn_.valid = false;
     // Draw order: shadow casters before receivers (the floor), each by increasing mesh bounding
     // box volume, so that small objects are drawn before the table they stand on.
     draw_order_.resize(scene.instances.size());
@@ -468,6 +487,15 @@ class GlRenderer {
   }
 
   const SceneDescription& scene() const { return scene_; }
+
+  /// What the last render() drew (GlRendererOptions::incremental).
+  struct DrawStats {
+    bool everything = true;          ///< the whole image and shadow window
+    std::size_t rectangles = 0;      ///< screen rectangles cleared and redrawn
+    std::size_t pixels = 0;          ///< pixels in them (overlaps counted twice)
+    std::size_t shadow_texels = 0;   ///< shadow-map texels cleared and redrawn
+  };
+  const DrawStats& last_draw() const { return stats_; }
 
   /// Renders one frame seen by scene().cameras[camera_index].
   RenderOutput render(const FrameState& frame, std::size_t camera_index = 0) {
@@ -495,9 +523,15 @@ class GlRenderer {
     const CameraModel model = camera_model(camera);
     context_->make_current();
     ensure_targets(camera.width, camera.height);
+    const int w = camera.width, h = camera.height;
+    const PixelRect whole{0, 0, w, h};
 
+    // The targets hold this camera's previous frame (incremental drawing) until drawing starts.
+    const bool keep = options_.incremental && drawn_.valid && drawn_.camera == camera_index;
+    drawn_.valid = false;
     const bool draw_rod = scene_.rod.present && frame.rod.nodes.rows() >= 2;
-    if (draw_rod) {
+    const bool rod_changed = !keep || draw_rod != drawn_.rod || (draw_rod && !drawn_.same_rod(frame.rod));
+    if (draw_rod && rod_changed) {
       TubeOptions tube;
       tube.sides = scene_.rod.sides;
       tube.subdivisions = scene_.rod.subdivisions;
@@ -506,52 +540,6 @@ class GlRenderer {
     }
 
     const ShadowProjection shadow = options_.shadows ? shadow_projection(frame, draw_rod) : ShadowProjection{};
-    if (options_.shadows) {
-      // Depth of the shadow casters' front faces (back faces culled: the meshes are closed, and
-      // the main pass culls them too), rendered and cleared over the window only.
-      glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo_);
-      glViewport(0, 0, shadow.window_x, shadow.window_y);
-      glEnable(GL_SCISSOR_TEST);  // one texel beyond the window: a bilinear tap at its edge reads it
-      glScissor(0, 0, std::min(shadow.window_x + 1, options_.shadow_map_size), std::min(shadow.window_y + 1, options_.shadow_map_size));
-      glClear(GL_DEPTH_BUFFER_BIT);
-      glDisable(GL_SCISSOR_TEST);
-      glEnable(GL_DEPTH_TEST);
-      glEnable(GL_CULL_FACE);
-      glCullFace(GL_BACK);
-      glFrontFace(GL_CCW);
-      glEnable(GL_POLYGON_OFFSET_FILL);
-      glPolygonOffset(1.5f, 2.0f);
-      glUseProgram(shadow_program_);
-      glUniformMatrix4fv(u_shadow_light_vp_, 1, GL_FALSE, shadow.view_projection.data());
-      for (std::size_t i = 0; i < scene_.instances.size(); ++i) {
-        if (!scene_.instances[i].casts_shadow) continue;
-        const Eigen::Matrix4f m = frame.instance_poses[i].matrix().cast<float>();
-        glUniformMatrix4fv(u_shadow_model_, 1, GL_FALSE, m.data());
-        draw(meshes_[static_cast<std::size_t>(scene_.instances[i].mesh)]);
-      }
-      if (draw_rod) {
-        const Eigen::Matrix4f identity = Eigen::Matrix4f::Identity();
-        glUniformMatrix4fv(u_shadow_model_, 1, GL_FALSE, identity.data());
-        draw(rod_gpu_);
-      }
-      glDisable(GL_POLYGON_OFFSET_FILL);
-    }
-
-    // Main pass: colour to attachment 0, object id to attachment 1 (when the mask is read).
-    glBindFramebuffer(GL_FRAMEBUFFER, main_fbo_);
-    glViewport(0, 0, camera.width, camera.height);
-    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, options_.read_mask ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
-    glDrawBuffers(2, buffers);
-    const Eigen::Vector3f bg = scene_.background_color.cwiseMax(0.0f).cwiseMin(1.0f);
-    const float clear_color[4] = {std::pow(bg.x(), 1.0f / 2.2f), std::pow(bg.y(), 1.0f / 2.2f), std::pow(bg.z(), 1.0f / 2.2f), 1.0f};
-    const GLuint clear_id[4] = {0, 0, 0, 0};
-    const GLfloat clear_depth = 1.0f;
-    glClearBufferfv(GL_COLOR, 0, clear_color);
-    if (options_.read_mask) glClearBufferuiv(GL_COLOR, 1, clear_id);
-    glClearBufferfv(GL_DEPTH, 0, &clear_depth);
-    glEnable(GL_DEPTH_TEST);
-    glEnable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
     // OpenCV camera (y down, z forward) -> GL eye (y up, z back), then the image turned upside
     // down (clip y negated) so that GL's bottom-up rows come back top row first: the mirror turns
     // counter-clockwise front faces clockwise.
@@ -560,7 +548,6 @@ class GlRenderer {
     cv_to_gl(2, 2) = -1;
     Eigen::Matrix4d flip_rows = Eigen::Matrix4d::Identity();
     flip_rows(1, 1) = -1;
-    glFrontFace(GL_CW);
     Eigen::Matrix4d world_to_camera = Eigen::Matrix4d::Identity();
     world_to_camera.topLeftCorner<3, 3>() = model.R;
     world_to_camera.topRightCorner<3, 1>() = model.t;
@@ -570,87 +557,32 @@ class GlRenderer {
                                 camera.far_clip) *
          cv_to_gl * world_to_camera)
             .cast<float>();
-    const Lighting& light = scene_.lighting;
-    const Eigen::Vector3f light_direction = light.direction.normalized().cast<float>();
-    const Eigen::Vector3f light_position = light.position.cast<float>();
-    const Eigen::Vector3f light_color = light.color * light.intensity;
-    const Eigen::Vector3f ambient = light.ambient_color * light.ambient_intensity;
-    const Eigen::Vector3f eye = camera.position.cast<float>();
-    const float spot_cos = static_cast<float>(std::cos(light.spot_cone_deg * std::numbers::pi / 180.0));
-    const float shadow_window[2] = {static_cast<float>(shadow.window_x), static_cast<float>(shadow.window_y)};
-    light_set_ = light.kind == LightKind::spot ? 1 : 0;
-    for (std::size_t variant = 0; variant < 2; ++variant) {  // per-frame uniforms of every program
-      for (std::size_t kind = 0; kind < texture_kinds; ++kind) {
-        const GLuint program = programs_[light_set_][variant][kind];
-        if (program == 0) continue;
-        const Uniforms& u = uniforms_[light_set_][variant][kind];
-        glUseProgram(program);
-        glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, view_projection.data());
-        glUniformMatrix4fv(u.light_view_projection, 1, GL_FALSE, shadow.view_projection.data());
-        glUniform3fv(u.light_direction, 1, light_direction.data());
-        glUniform3fv(u.light_position, 1, light_position.data());
-        glUniform1f(u.spot_cos, spot_cos);
-        glUniform3fv(u.light_color, 1, light_color.data());
-        glUniform3fv(u.ambient, 1, ambient.data());
-        glUniform3fv(u.camera_position, 1, eye.data());
-        glUniform1i(u.shadow_map, 0);
-        glUniform2fv(u.shadow_window, 1, shadow_window);
-        glUniform1f(u.shadow_size, static_cast<float>(options_.shadow_map_size));
-        glUniform1f(u.shadow_bias, shadow.bias);
-      }
-    }
-    current_kind_ = texture_kinds;  // none: the next set_material binds its program
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, shadow_texture_);
 
-    // Rod first, then the instances in draw_order_ (small before large, large receivers such as
-    // the floor last): occluders first lets llvmpipe's early depth test skip hidden blocks.
-    if (draw_rod) {
-      set_material(scene_.materials[static_cast<std::size_t>(scene_.rod.material)], true);
-      set_model(math::Pose<double>{});
-      glUniform1ui(current_uniforms().object_id, scene_.rod.object_id);
-      draw(rod_gpu_);
-    }
-    auto draw_instance = [&](std::size_t i, bool shadowed) {
-      const Instance& inst = scene_.instances[i];
-      set_material(scene_.materials[static_cast<std::size_t>(inst.material)], shadowed);
-      set_model(frame.instance_poses[i]);
-      glUniform1ui(current_uniforms().object_id, inst.object_id);
-      draw(meshes_[static_cast<std::size_t>(inst.mesh)]);
-    };
-    for (const std::size_t i : draw_order_) {
-      if (scene_.instances[i].casts_shadow || !options_.shadows) {
-        draw_instance(i, true);
-        continue;
-      }
-      // A receiver: the shadow lookup only inside the screen rectangle where it can be shadowed,
-      // the program without it on the rest of the image (the same pixels: outside the shadow
-      // map's window the lookup returns 1).
-      const PixelRect inside = shadowed_screen_rect(frame.instance_poses[i], mesh_bounds_[static_cast<std::size_t>(scene_.instances[i].mesh)],
-                                                    shadow, view_projection, camera.width, camera.height);
-      glEnable(GL_SCISSOR_TEST);
-      for (const PixelRect& r : complement(inside, camera.width, camera.height)) {
-        glScissor(r.x0, r.y0, r.x1 - r.x0, r.y1 - r.y0);
-        draw_instance(i, false);
-      }
-      if (!inside.empty()) {
-        glScissor(inside.x0, inside.y0, inside.x1 - inside.x0, inside.y1 - inside.y0);
-        draw_instance(i, true);
-      }
-      glDisable(GL_SCISSOR_TEST);
-    }
-    if (frame.goal_pose) {
-      const std::array<Eigen::Vector3f, 3> colors = {Eigen::Vector3f(0.85f, 0.1f, 0.1f), Eigen::Vector3f(0.1f, 0.7f, 0.1f),
-                                                     Eigen::Vector3f(0.1f, 0.2f, 0.9f)};
-      for (std::size_t a = 0; a < 3; ++a) {
-        Material m;
-        m.base_color = colors[a];
-        set_material(m, true);
-        set_model(*frame.goal_pose);
-        glUniform1ui(current_uniforms().object_id, scene_.goal_marker.object_id);
-        draw(triad_[a]);
+    // What to draw: the whole image, or (incremental) the rectangles around what changed; the
+    // shadow map's window, or its texels that changed casters cover (before and after).
+    const bool incremental = keep && (!options_.shadows || (shadow.windowed && shadow.view_projection == drawn_.shadow_view_projection));
+    dirty_.clear();
+    light_dirty_.clear();
+    if (incremental) {
+      collect_changes(frame, draw_rod, rod_changed, shadow, view_projection, w, h);
+    } else {
+      dirty_.push_back(whole);
+      // The window and one texel beyond it: a bilinear tap at its edge reads it.
+      if (options_.shadows) light_dirty_.push_back(PixelRect{0, 0, shadow.limit_x(options_.shadow_map_size), shadow.limit_y(options_.shadow_map_size)});
+      if (draw_rod) {
+        rod_chunk_boxes(drawn_.rod_chunks);
+      } else {
+        drawn_.rod_chunks.clear();
       }
     }
+
+    merge_rects(dirty_, max_dirty_rects);
+    stats_ = DrawStats{!incremental, dirty_.size(), 0, 0};
+    for (const PixelRect& r : dirty_) stats_.pixels += static_cast<std::size_t>(area(r));
+    for (const PixelRect& r : light_dirty_) stats_.shadow_texels += static_cast<std::size_t>(area(r));
+
+    if (!light_dirty_.empty()) draw_shadow_pass(frame, draw_rod, incremental, shadow);
+    if (!dirty_.empty()) draw_main_pass(frame, camera, draw_rod, incremental, shadow, view_projection);
 
     // Resolve MSAA, then read back. Rows come back top row first (the image was drawn upside down).
     GLuint read_fbo = main_fbo_;
@@ -669,7 +601,6 @@ class GlRenderer {
     glFrontFace(GL_CCW);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, read_fbo);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    const int w = camera.width, h = camera.height;
     const std::size_t pixels = static_cast<std::size_t>(w) * h;
     out.width = w;
     out.height = h;
@@ -716,6 +647,7 @@ class GlRenderer {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     const GLenum error = glGetError();
     if (error != GL_NO_ERROR) manisoft::detail::fail("GlRenderer::render: OpenGL error 0x", std::hex, error);
+    if (options_.incremental) drawn_.record(frame, draw_rod, rod_mesh_, camera_index, shadow.view_projection);
   }
 
  private:
@@ -797,6 +729,9 @@ class GlRenderer {
     bool windowed = false;
     Eigen::Matrix4f view = Eigen::Matrix4f::Identity();
     Eigen::Vector2f window_min = Eigen::Vector2f::Zero(), window_max = Eigen::Vector2f::Zero();
+    // The texels the pass may clear: the window and one beyond (a bilinear tap at its edge).
+    int limit_x(int map_size) const { return std::min(window_x + 1, map_size); }
+    int limit_y(int map_size) const { return std::min(window_y + 1, map_size); }
   };
 
   /// A rectangle of framebuffer pixels [x0, x1) x [y0, y1).
@@ -814,21 +749,25 @@ class GlRenderer {
 
   // The pixels where a receiver can be in shadow: its world bounding box clipped to the prism
   // that the shadow map's window sweeps along the light (light-view x, y inside the window, one
-  // texel added), projected into the image, plus one pixel. The whole image when that cannot be
-  // bounded (spot light, part of the clipped box behind the camera); empty when the box misses
-  // the prism.
+  // texel added). The whole image when that cannot be bounded (spot light).
   static PixelRect shadowed_screen_rect(const math::Pose<double>& pose, const Eigen::AlignedBox3f& body_box, const ShadowProjection& shadow,
                                         const Eigen::Matrix4f& view_projection, int width, int height) {
+    if (!shadow.windowed || body_box.isEmpty()) return PixelRect{0, 0, width, height};
+    const Eigen::Vector2f margin = Eigen::Vector2f::Constant((shadow.window_max.x() - shadow.window_min.x()) / static_cast<float>(shadow.window_x));
+    return prism_screen_rect(world_box(pose, body_box), shadow.view, shadow.window_min - margin, shadow.window_max + margin, view_projection, width,
+                             height);
+  }
+
+  // The pixels of a world box's part inside the prism {light-view x, y in [lo, hi]} (`light_view`:
+  // world to the light's view), projected into the image, plus one pixel: the box clipped face by
+  // face. The whole image when part of the clipped box is behind the camera; empty when the box
+  // misses the prism.
+  static PixelRect prism_screen_rect(const Eigen::AlignedBox3f& box, const Eigen::Matrix4f& light_view, const Eigen::Vector2f& lo,
+                                     const Eigen::Vector2f& hi, const Eigen::Matrix4f& view_projection, int width, int height) {
     const PixelRect whole{0, 0, width, height};
-    if (!shadow.windowed || body_box.isEmpty()) return whole;
-    const Eigen::Matrix4f model = pose.matrix().cast<float>();
-    Eigen::AlignedBox3f box;
-    for (int c = 0; c < 8; ++c) {
-      box.extend((model.topLeftCorner<3, 3>() * body_box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)) + model.topRightCorner<3, 1>()).eval());
-    }
+    if (box.isEmpty()) return PixelRect{};
     // The box's faces as corner indices (bit 0: x max, bit 1: y max, bit 2: z max).
     static constexpr std::array<std::array<int, 4>, 6> faces = {{{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}}};
-    const float margin = (shadow.window_max.x() - shadow.window_min.x()) / static_cast<float>(shadow.window_x);  // one texel
     Eigen::AlignedBox2f pixels;
     for (const auto& face : faces) {
       // Sutherland-Hodgman against the prism's four planes: each adds at most one vertex.
@@ -838,8 +777,8 @@ class GlRenderer {
       for (int plane = 0; plane < 4 && n > 0; ++plane) {
         const int axis = plane / 2;
         const float sign = plane % 2 == 0 ? 1.0f : -1.0f;  // inside: sign (light-view coordinate - bound) >= 0
-        const float bound = plane % 2 == 0 ? shadow.window_min[axis] - margin : shadow.window_max[axis] + margin;
-        auto distance = [&](const Eigen::Vector3f& p) { return sign * (shadow.view.row(axis).head<3>().dot(p) + shadow.view(axis, 3) - bound); };
+        const float bound = plane % 2 == 0 ? lo[axis] : hi[axis];
+        auto distance = [&](const Eigen::Vector3f& p) { return sign * (light_view.row(axis).head<3>().dot(p) + light_view(axis, 3) - bound); };
         int m = 0;
         for (int k = 0; k < n; ++k) {
           const Eigen::Vector3f& a = polygon[static_cast<std::size_t>(k)];
@@ -858,10 +797,7 @@ class GlRenderer {
                                       (clip.y() / clip.w() + 1.0f) * 0.5f * static_cast<float>(height)));
       }
     }
-    if (pixels.isEmpty()) return PixelRect{};
-    auto clamp_to = [](float v, int hi) { return static_cast<int>(std::clamp(v, 0.0f, static_cast<float>(hi))); };
-    return PixelRect{clamp_to(std::floor(pixels.min().x()) - 1.0f, width), clamp_to(std::floor(pixels.min().y()) - 1.0f, height),
-                     clamp_to(std::ceil(pixels.max().x()) + 1.0f, width), clamp_to(std::ceil(pixels.max().y()) + 1.0f, height)};
+    return to_pixels(pixels, 1.0f, width, height);
   }
 
   // A spot light: a perspective frustum over its cone, the whole map. A directional light: an
@@ -924,6 +860,431 @@ class GlRenderer {
     out.window_max = Eigen::Vector2f(static_cast<float>(-r + k1[0] * tau), static_cast<float>(-r + k1[1] * tau));
     return out;
   }
+
+  // Depth of the shadow casters' front faces (back faces culled: the meshes are closed, and the
+  // main pass culls them too) over the texel rectangles in light_dirty_, each cleared first; with
+  // `cull`, a caster is drawn only into the rectangles its box reaches.
+  void draw_shadow_pass(const FrameState& frame, bool draw_rod, bool cull, const ShadowProjection& shadow) {
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo_);
+    glViewport(0, 0, shadow.window_x, shadow.window_y);
+    glEnable(GL_SCISSOR_TEST);
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.5f, 2.0f);
+    glUseProgram(shadow_program_);
+    glUniformMatrix4fv(u_shadow_light_vp_, 1, GL_FALSE, shadow.view_projection.data());
+    const PixelRect window{0, 0, shadow.limit_x(options_.shadow_map_size), shadow.limit_y(options_.shadow_map_size)};
+    caster_rects_.resize(scene_.instances.size());
+    for (std::size_t i = 0; i < scene_.instances.size(); ++i) {
+      const Eigen::AlignedBox3f& body_box = mesh_bounds_[static_cast<std::size_t>(scene_.instances[i].mesh)];
+      caster_rects_[i] = cull ? light_rect(world_box(frame.instance_poses[i], body_box), shadow) : window;
+    }
+    for (const PixelRect& rect : light_dirty_) {
+      scissor(rect);
+      glClear(GL_DEPTH_BUFFER_BIT);
+    }
+    // Each caster once, over the cleared rectangles it reaches (see reach()).
+    for (std::size_t i = 0; i < scene_.instances.size(); ++i) {
+      const PixelRect box = reach(caster_rects_[i], light_dirty_);
+      if (!scene_.instances[i].casts_shadow || box.empty()) continue;
+      scissor(box);
+      const Eigen::Matrix4f m = frame.instance_poses[i].matrix().cast<float>();
+      glUniformMatrix4fv(u_shadow_model_, 1, GL_FALSE, m.data());
+      draw(meshes_[static_cast<std::size_t>(scene_.instances[i].mesh)]);
+    }
+    if (draw_rod) {
+      scissor(reach(window, light_dirty_));
+      const Eigen::Matrix4f identity = Eigen::Matrix4f::Identity();
+      glUniformMatrix4fv(u_shadow_model_, 1, GL_FALSE, identity.data());
+      draw(rod_gpu_);
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_SCISSOR_TEST);
+  }
+
+  // The shadow-map texels (window coordinates) a world box can cover, two added a side.
+  PixelRect light_rect(const Eigen::AlignedBox3f& box, const ShadowProjection& shadow) const {
+    Eigen::AlignedBox2f texels;
+    for (int c = 0; c < 8 && !box.isEmpty(); ++c) {
+      const Eigen::Vector4f p = shadow.view_projection * box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).homogeneous();
+      texels.extend(Eigen::Vector2f((p.x() / p.w() + 1.0f) * 0.5f * static_cast<float>(shadow.window_x),
+                                    (p.y() / p.w() + 1.0f) * 0.5f * static_cast<float>(shadow.window_y)));
+    }
+    return to_pixels(texels, 2.0f, shadow.limit_x(options_.shadow_map_size), shadow.limit_y(options_.shadow_map_size));
+  }
+
+  // The main pass over the rectangles in dirty_ (each cleared, then drawn with everything that
+  // can reach it: the same draws in the same order as over the whole image).
+  void draw_main_pass(const FrameState& frame, const Camera& camera, bool draw_rod, bool cull, const ShadowProjection& shadow,
+                      const Eigen::Matrix4f& view_projection) {
+    const int w = camera.width, h = camera.height;
+    // Colour to attachment 0, object id to attachment 1 (when the mask is read).
+    glBindFramebuffer(GL_FRAMEBUFFER, main_fbo_);
+    glViewport(0, 0, w, h);
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, options_.read_mask ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
+    glDrawBuffers(2, buffers);
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CW);  // the image is drawn upside down (see render_into)
+    const Lighting& light = scene_.lighting;
+    const Eigen::Vector3f light_direction = light.direction.normalized().cast<float>();
+    const Eigen::Vector3f light_position = light.position.cast<float>();
+    const Eigen::Vector3f light_color = light.color * light.intensity;
+    const Eigen::Vector3f ambient = light.ambient_color * light.ambient_intensity;
+    const Eigen::Vector3f eye = camera.position.cast<float>();
+    const float spot_cos = static_cast<float>(std::cos(light.spot_cone_deg * std::numbers::pi / 180.0));
+    const float shadow_window[2] = {static_cast<float>(shadow.window_x), static_cast<float>(shadow.window_y)};
+    light_set_ = light.kind == LightKind::spot ? 1 : 0;
+    for (std::size_t variant = 0; variant < 2; ++variant) {  // per-frame uniforms of every program
+      for (std::size_t kind = 0; kind < texture_kinds; ++kind) {
+        const GLuint program = programs_[light_set_][variant][kind];
+        if (program == 0) continue;
+        const Uniforms& u = uniforms_[light_set_][variant][kind];
+        glUseProgram(program);
+        glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, view_projection.data());
+        glUniformMatrix4fv(u.light_view_projection, 1, GL_FALSE, shadow.view_projection.data());
+        glUniform3fv(u.light_direction, 1, light_direction.data());
+        glUniform3fv(u.light_position, 1, light_position.data());
+        glUniform1f(u.spot_cos, spot_cos);
+        glUniform3fv(u.light_color, 1, light_color.data());
+        glUniform3fv(u.ambient, 1, ambient.data());
+        glUniform3fv(u.camera_position, 1, eye.data());
+        glUniform1i(u.shadow_map, 0);
+        glUniform2fv(u.shadow_window, 1, shadow_window);
+        glUniform1f(u.shadow_size, static_cast<float>(options_.shadow_map_size));
+        glUniform1f(u.shadow_bias, shadow.bias);
+      }
+    }
+    current_kind_ = texture_kinds;  // none: the next set_material binds its program
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, shadow_texture_);
+
+    // Per frame: each instance's screen rectangle (to skip it where it cannot be: `cull`) and each
+    // receiver's rectangle where it can be in shadow.
+    const PixelRect whole{0, 0, w, h};
+    instance_rects_.resize(scene_.instances.size());
+    receiver_inside_.resize(scene_.instances.size());
+    for (std::size_t i = 0; i < scene_.instances.size(); ++i) {
+      const Eigen::AlignedBox3f& body_box = mesh_bounds_[static_cast<std::size_t>(scene_.instances[i].mesh)];
+      instance_rects_[i] = cull ? screen_rect(world_box(frame.instance_poses[i], body_box), view_projection, w, h) : whole;
+      if (options_.shadows && !scene_.instances[i].casts_shadow) {
+        receiver_inside_[i] = shadowed_screen_rect(frame.instance_poses[i], body_box, shadow, view_projection, w, h);
+      }
+    }
+    PixelRect rod_rect = whole, goal_rect = whole;
+    if (cull && draw_rod) {
+      Eigen::AlignedBox3f rod_box;
+      for (const Eigen::AlignedBox3f& b : drawn_.rod_chunks) rod_box.extend(b);
+      rod_rect = screen_rect(rod_box, view_projection, w, h);
+    }
+    if (cull && frame.goal_pose) goal_rect = screen_rect(world_box(*frame.goal_pose, triad_bounds_), view_projection, w, h);
+
+    const Eigen::Vector3f bg = scene_.background_color.cwiseMax(0.0f).cwiseMin(1.0f);
+    const float clear_color[4] = {std::pow(bg.x(), 1.0f / 2.2f), std::pow(bg.y(), 1.0f / 2.2f), std::pow(bg.z(), 1.0f / 2.2f), 1.0f};
+    const GLuint clear_id[4] = {0, 0, 0, 0};
+    const GLfloat clear_depth = 1.0f;
+    auto draw_instance = [&](std::size_t i, bool shadowed) {
+      const Instance& inst = scene_.instances[i];
+      set_material(scene_.materials[static_cast<std::size_t>(inst.material)], shadowed);
+      set_model(frame.instance_poses[i]);
+      glUniform1ui(current_uniforms().object_id, inst.object_id);
+      draw(meshes_[static_cast<std::size_t>(inst.mesh)]);
+    };
+    glEnable(GL_SCISSOR_TEST);
+    for (const PixelRect& rect : dirty_) {
+      scissor(rect);
+      glClearBufferfv(GL_COLOR, 0, clear_color);
+      if (options_.read_mask) glClearBufferuiv(GL_COLOR, 1, clear_id);
+      glClearBufferfv(GL_DEPTH, 0, &clear_depth);
+    }
+    // Rod first, then the instances in draw_order_ (small before large, large receivers such as
+    // the floor last): occluders first lets llvmpipe's early depth test skip hidden blocks. Each
+    // once, over the cleared rectangles it reaches (see reach()).
+    if (const PixelRect box = reach(rod_rect, dirty_); draw_rod && !box.empty()) {
+      scissor(box);
+      set_material(scene_.materials[static_cast<std::size_t>(scene_.rod.material)], true);
+      set_model(math::Pose<double>{});
+      glUniform1ui(current_uniforms().object_id, scene_.rod.object_id);
+      draw(rod_gpu_);
+    }
+    for (const std::size_t i : draw_order_) {
+      const PixelRect box = reach(instance_rects_[i], dirty_);
+      if (box.empty()) continue;
+      if (scene_.instances[i].casts_shadow || !options_.shadows) {
+        scissor(box);
+        draw_instance(i, true);
+        continue;
+      }
+      // A receiver: the shadow lookup only inside the screen rectangle where it can be shadowed,
+      // the program without it on the rest (the same pixels: outside the shadow map's window the
+      // lookup returns 1).
+      for (const PixelRect& r : complement(receiver_inside_[i], w, h)) {
+        const PixelRect part = intersect(r, box);
+        if (part.empty()) continue;
+        scissor(part);
+        draw_instance(i, false);
+      }
+      if (const PixelRect part = intersect(receiver_inside_[i], box); !part.empty()) {
+        scissor(part);
+        draw_instance(i, true);
+      }
+    }
+    if (const PixelRect box = reach(goal_rect, dirty_); frame.goal_pose && !box.empty()) {
+      scissor(box);
+      const std::array<Eigen::Vector3f, 3> colors = {Eigen::Vector3f(0.85f, 0.1f, 0.1f), Eigen::Vector3f(0.1f, 0.7f, 0.1f),
+                                                     Eigen::Vector3f(0.1f, 0.2f, 0.9f)};
+      for (std::size_t a = 0; a < 3; ++a) {
+        Material m;
+        m.base_color = colors[a];
+        set_material(m, true);
+        set_model(*frame.goal_pose);
+        glUniform1ui(current_uniforms().object_id, scene_.goal_marker.object_id);
+        draw(triad_[a]);
+      }
+    }
+    glDisable(GL_SCISSOR_TEST);
+  }
+
+  static void scissor(const PixelRect& r) { glScissor(r.x0, r.y0, r.x1 - r.x0, r.y1 - r.y0); }
+
+  // Where a drawable with screen (or shadow-map) rectangle `r` is drawn: the bounding rectangle of
+  // its overlaps with the cleared rectangles. Between those, its fragments meet the depth the
+  // targets already hold, which is this frame's (nothing there changed), and fail the depth test
+  // (GL_LESS: the same fragment, or one behind): drawing once over the bounding rectangle costs
+  // one pass over the geometry instead of one per rectangle.
+  static PixelRect reach(const PixelRect& r, const std::vector<PixelRect>& cleared) {
+    PixelRect box;
+    for (const PixelRect& c : cleared) {
+      const PixelRect part = intersect(r, c);
+      if (part.empty()) continue;
+      box = box.empty() ? part
+                        : PixelRect{std::min(box.x0, part.x0), std::min(box.y0, part.y0), std::max(box.x1, part.x1), std::max(box.y1, part.y1)};
+    }
+    return box;
+  }
+
+  // Incremental drawing: fills dirty_ with the screen rectangles that changed since the drawn
+  // frame and light_dirty_ with the shadow-map texels whose casters changed; refreshes
+  // drawn_.rod_chunks to this frame's tube. Every box is taken where the thing was and where it is.
+  void collect_changes(const FrameState& frame, bool draw_rod, bool rod_changed, const ShadowProjection& shadow, const Eigen::Matrix4f& view_projection,
+                       int w, int h) {
+    auto changed = [&](const Eigen::AlignedBox3f& box, bool casts_shadow) {
+      dirty_.push_back(screen_rect(box, view_projection, w, h));
+      if (casts_shadow && options_.shadows) light_dirty_.push_back(light_rect(box, shadow));
+    };
+    for (std::size_t i = 0; i < scene_.instances.size(); ++i) {
+      const math::Pose<double>& before = drawn_.poses[i];
+      const math::Pose<double>& now = frame.instance_poses[i];
+      if (before.rotation == now.rotation && before.translation == now.translation) continue;
+      const Eigen::AlignedBox3f& body_box = mesh_bounds_[static_cast<std::size_t>(scene_.instances[i].mesh)];
+      changed(world_box(before, body_box), scene_.instances[i].casts_shadow);
+      changed(world_box(now, body_box), scene_.instances[i].casts_shadow);
+    }
+    if (rod_changed) {
+      // The tube in chunks of rings: a chunk whose vertices changed is redrawn where it was and
+      // where it is (the chunk boxes of the drawn frame are kept in drawn_.rod_chunks).
+      chunk_scratch_.clear();
+      if (draw_rod) rod_chunk_boxes(chunk_scratch_);
+      const bool same_layout = drawn_.rod && draw_rod && rod_mesh_.positions.size() == drawn_.rod_positions.size();
+      const std::size_t chunks = std::max(chunk_scratch_.size(), drawn_.rod_chunks.size());
+      for (std::size_t c = 0; c < chunks; ++c) {
+        const bool before = c < drawn_.rod_chunks.size(), now = c < chunk_scratch_.size();
+        if (same_layout && same_chunk(c)) continue;
+        if (before) changed(drawn_.rod_chunks[c], true);
+        if (now) changed(chunk_scratch_[c], true);
+      }
+      std::swap(drawn_.rod_chunks, chunk_scratch_);
+    }
+    const bool goal_same = frame.goal_pose.has_value() == drawn_.goal.has_value() &&
+                           (!frame.goal_pose || (frame.goal_pose->rotation == drawn_.goal->rotation && frame.goal_pose->translation == drawn_.goal->translation));
+    if (!goal_same) {
+      if (drawn_.goal) changed(world_box(*drawn_.goal, triad_bounds_), false);
+      if (frame.goal_pose) changed(world_box(*frame.goal_pose, triad_bounds_), false);
+    }
+    merge_rects(light_dirty_, max_light_rects);
+    // The pixels whose shadow lookup can read a changed texel: every drawable's box clipped to the
+    // prism that the texels (plus two: the 2 x 2 lookup and rounding) sweep along the light.
+    const Eigen::Vector2f texel = (shadow.window_max - shadow.window_min).cwiseQuotient(Eigen::Vector2f(shadow.window_x, shadow.window_y));
+    for (const PixelRect& r : light_dirty_) {
+      const Eigen::Vector2f lo = shadow.window_min + Eigen::Vector2f(r.x0 - 2.0f, r.y0 - 2.0f).cwiseProduct(texel);
+      const Eigen::Vector2f hi = shadow.window_min + Eigen::Vector2f(r.x1 + 2.0f, r.y1 + 2.0f).cwiseProduct(texel);
+      auto receives = [&](const Eigen::AlignedBox3f& box) {
+        const PixelRect p = prism_screen_rect(box, shadow.view, lo, hi, view_projection, w, h);
+        if (!p.empty()) dirty_.push_back(p);
+      };
+      for (std::size_t i = 0; i < scene_.instances.size(); ++i) {
+        receives(world_box(frame.instance_poses[i], mesh_bounds_[static_cast<std::size_t>(scene_.instances[i].mesh)]));
+      }
+      if (draw_rod) {
+        for (const Eigen::AlignedBox3f& b : drawn_.rod_chunks) receives(b);
+      }
+      if (frame.goal_pose) receives(world_box(*frame.goal_pose, triad_bounds_));
+    }
+  }
+
+  // The tube's vertices (make_tube_into): rings of (sides + 1) along the rod, then the start and
+  // the end cap (sides + 2 each, lying on the end rings). Chunk c is rings [c k, (c + 1) k]
+  // (k = rod_chunk_rings; the ring shared with the next chunk included, so that the triangles
+  // between chunks are inside), with its cap for the end chunks.
+  struct ChunkVertices {
+    std::size_t ring_first = 0, ring_end = 0, cap_first = 0, cap_end = 0;
+  };
+  std::size_t rod_chunk_count() const {
+    const std::size_t ring = static_cast<std::size_t>(scene_.rod.sides) + 1, cap = ring + 1;
+    const std::size_t rings = (rod_mesh_.positions.size() - 2 * cap) / ring;
+    return (rings - 1 + rod_chunk_rings - 1) / rod_chunk_rings;
+  }
+  ChunkVertices rod_chunk(std::size_t c) const {
+    const std::size_t ring = static_cast<std::size_t>(scene_.rod.sides) + 1, cap = ring + 1;
+    const std::size_t rings_end = rod_mesh_.positions.size() - 2 * cap;
+    ChunkVertices v{c * rod_chunk_rings * ring, std::min(rings_end, ((c + 1) * rod_chunk_rings + 1) * ring), rings_end, rings_end};
+    if (c == 0) v.cap_end = rings_end + cap;
+    if (c + 1 == rod_chunk_count()) {
+      v.cap_first = c == 0 ? rings_end : rings_end + cap;
+      v.cap_end = rings_end + 2 * cap;
+    }
+    return v;
+  }
+
+  // Whether chunk c of the tube has the drawn frame's positions and normals (same vertex count).
+  bool same_chunk(std::size_t c) const {
+    const ChunkVertices v = rod_chunk(c);
+    auto same = [&](std::size_t first, std::size_t end) {
+      for (std::size_t k = first; k < end; ++k) {
+        if (rod_mesh_.positions[k] != drawn_.rod_positions[k] || rod_mesh_.normals[k] != drawn_.rod_normals[k]) return false;
+      }
+      return true;
+    };
+    return same(v.ring_first, v.ring_end) && same(v.cap_first, v.cap_end);
+  }
+
+  // World boxes of the current tube's chunks (their rings: the caps lie inside).
+  void rod_chunk_boxes(std::vector<Eigen::AlignedBox3f>& boxes) const {
+    boxes.clear();
+    for (std::size_t c = 0; c < rod_chunk_count(); ++c) {
+      const ChunkVertices v = rod_chunk(c);
+      Eigen::AlignedBox3f box;
+      for (std::size_t k = v.ring_first; k < v.ring_end; ++k) box.extend(rod_mesh_.positions[k]);
+      boxes.push_back(box);
+    }
+  }
+
+  static Eigen::AlignedBox3f world_box(const math::Pose<double>& pose, const Eigen::AlignedBox3f& body_box) {
+    Eigen::AlignedBox3f box;
+    if (body_box.isEmpty()) return box;
+    const Eigen::Matrix4f model = pose.matrix().cast<float>();
+    for (int c = 0; c < 8; ++c) {
+      box.extend((model.topLeftCorner<3, 3>() * body_box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)) + model.topRightCorner<3, 1>()).eval());
+    }
+    return box;
+  }
+
+  // Framebuffer pixels covering a set of points given in pixel units, `margin` added a side,
+  // clamped to [0, width) x [0, height).
+  static PixelRect to_pixels(const Eigen::AlignedBox2f& points, float margin, int width, int height) {
+    if (points.isEmpty()) return PixelRect{};
+    auto clamp_to = [](float v, int hi) { return static_cast<int>(std::clamp(v, 0.0f, static_cast<float>(hi))); };
+    return PixelRect{clamp_to(std::floor(points.min().x()) - margin, width), clamp_to(std::floor(points.min().y()) - margin, height),
+                     clamp_to(std::ceil(points.max().x()) + margin, width), clamp_to(std::ceil(points.max().y()) + margin, height)};
+  }
+
+  // The pixels a world box can cover: its corners projected, two pixels added a side; the whole
+  // image when a corner is not in front of the camera.
+  static PixelRect screen_rect(const Eigen::AlignedBox3f& box, const Eigen::Matrix4f& view_projection, int width, int height) {
+    if (box.isEmpty()) return PixelRect{};
+    Eigen::AlignedBox2f pixels;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector4f clip = view_projection * box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).homogeneous();
+      if (!(clip.w() > 1e-6f)) return PixelRect{0, 0, width, height};
+      pixels.extend(Eigen::Vector2f((clip.x() / clip.w() + 1.0f) * 0.5f * static_cast<float>(width), (clip.y() / clip.w() + 1.0f) * 0.5f * static_cast<float>(height)));
+    }
+    return to_pixels(pixels, 2.0f, width, height);
+  }
+
+  static PixelRect intersect(const PixelRect& a, const PixelRect& b) {
+    return PixelRect{std::max(a.x0, b.x0), std::max(a.y0, b.y0), std::min(a.x1, b.x1), std::min(a.y1, b.y1)};
+  }
+
+  static long long area(const PixelRect& r) { return r.empty() ? 0 : static_cast<long long>(r.x1 - r.x0) * (r.y1 - r.y0); }
+
+  // Joins the rectangles into at most max_count: largest first, each joins the kept rectangle it
+  // adds the fewest pixels to when that adds none or no slot is left; then kept rectangles join
+  // while joining two adds no pixels. Empty rectangles are dropped. O(n max_count).
+  static void merge_rects(std::vector<PixelRect>& rects, std::size_t max_count) {
+    std::erase_if(rects, [](const PixelRect& r) { return r.empty(); });
+    std::sort(rects.begin(), rects.end(), [](const PixelRect& a, const PixelRect& b) { return area(a) > area(b); });
+    auto join = [](const PixelRect& a, const PixelRect& b) {
+      return PixelRect{std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1), std::max(a.y1, b.y1)};
+    };
+    auto cost = [&](const PixelRect& a, const PixelRect& b) { return area(join(a, b)) - area(a) - area(b); };
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < rects.size(); ++i) {
+      std::size_t best = 0;
+      long long best_cost = std::numeric_limits<long long>::max();
+      for (std::size_t j = 0; j < kept; ++j) {
+        if (const long long c = cost(rects[j], rects[i]); c < best_cost) {
+          best_cost = c;
+          best = j;
+        }
+      }
+      if (kept < std::max<std::size_t>(max_count, 1) && best_cost > 0) {
+        rects[kept++] = rects[i];
+      } else {
+        rects[best] = join(rects[best], rects[i]);
+      }
+    }
+    rects.resize(kept);
+    for (bool joined = true; joined;) {
+      joined = false;
+      for (std::size_t a = 0; a < rects.size() && !joined; ++a) {
+        for (std::size_t b = a + 1; b < rects.size() && !joined; ++b) {
+          if (cost(rects[a], rects[b]) > 0) continue;
+          rects[a] = join(rects[a], rects[b]);
+          rects.erase(rects.begin() + static_cast<std::ptrdiff_t>(b));
+          joined = true;
+        }
+      }
+    }
+  }
+
+  // The frame the targets hold (incremental drawing).
+  struct DrawnFrame {
+    bool valid = false;
+    std::size_t camera = 0;
+    std::vector<math::Pose<double>> poses;
+    bool rod = false;
+    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rod_nodes;
+    Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor> rod_directors;
+    double rod_radius = 0;
+    std::vector<Eigen::Vector3f> rod_positions, rod_normals;  // the drawn tube's vertices
+    std::vector<Eigen::AlignedBox3f> rod_chunks;              // and its chunks' world boxes
+    std::optional<math::Pose<double>> goal;
+    Eigen::Matrix4f shadow_view_projection = Eigen::Matrix4f::Zero();
+
+    bool same_rod(const RodShape& r) const {
+      return r.radius == rod_radius && r.nodes.rows() == rod_nodes.rows() && r.directors.rows() == rod_directors.rows() &&
+             (r.nodes.array() == rod_nodes.array()).all() && (r.directors.array() == rod_directors.array()).all();
+    }
+    void record(const FrameState& f, bool drew_rod, const Mesh& tube, std::size_t camera_index, const Eigen::Matrix4f& shadow_vp) {
+      poses = f.instance_poses;
+      rod = drew_rod;
+      if (drew_rod) {
+        rod_nodes = f.rod.nodes;
+        rod_directors = f.rod.directors;
+        rod_radius = f.rod.radius;
+        rod_positions = tube.positions;
+        rod_normals = tube.normals;
+      }
+      goal = f.goal_pose;
+      camera = camera_index;
+      shadow_view_projection = shadow_vp;
+      valid = true;
+    }
+  };
 
   const Uniforms& current_uniforms() const { return uniforms_[light_set_][current_shadowed_][current_kind_]; }
 
@@ -1001,6 +1362,7 @@ class GlRenderer {
       }
       check_framebuffer(s > 0 ? "multisampled" : "main");
     };
+    drawn_.valid = false;
     make_fbo(main_fbo_, main_rbs_, samples);
     if (samples > 0) make_fbo(resolve_fbo_, resolve_rbs_, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -1064,6 +1426,15 @@ class GlRenderer {
   GLuint main_fbo_ = 0, resolve_fbo_ = 0;
   std::array<GLuint, 3> main_rbs_{0, 0, 0}, resolve_rbs_{0, 0, 0};
   int target_width_ = 0, target_height_ = 0;
+  // Incremental drawing (GlRendererOptions::incremental).
+  static constexpr int rod_chunk_rings = 8;            // tube rings per chunk (two elements at 4 rings each)
+  static constexpr std::size_t max_dirty_rects = 12;   // screen rectangles cleared per frame, at most
+  DrawnFrame drawn_;
+  DrawStats stats_;
+  Eigen::AlignedBox3f triad_bounds_;                   // the goal marker, body frame
+  static constexpr std::size_t max_light_rects = 8;    // shadow-map rectangles cleared per frame, at most
+  std::vector<PixelRect> dirty_, instance_rects_, receiver_inside_, light_dirty_, caster_rects_;
+  std::vector<Eigen::AlignedBox3f> chunk_scratch_;
   std::vector<std::uint32_t> scratch_depth_;
   std::vector<std::array<std::uint8_t, 4>> scratch_rgba_;
   std::vector<float> upload_scratch_;
