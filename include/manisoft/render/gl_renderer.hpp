@@ -443,6 +443,7 @@ class GlRenderer {
   void set_scene(const SceneDescription& scene) {
     context_->make_current();
     validate_scene(scene);
+    drawn_.valid = false;  // the targets no longer hold a frame of the scene being set
     const std::size_t light_set = scene.lighting.kind == LightKind::spot ? 1 : 0;
     build_programs(light_set);
     // Receivers (instances that cast no shadow, e.g. the floor) are drawn without the shadow
@@ -469,7 +470,6 @@ class GlRenderer {
       detail_gl::upload(triad_[i], triad[i], false, upload_scratch_);
       for (const Eigen::Vector3f& p : triad[i].positions) triad_bounds_.extend(p);
     }
-    drawn_.valid = false;
     // Draw order: shadow casters before receivers (the floor), each by increasing mesh bounding
     // box volume, so that small objects are drawn before the table they stand on.
     draw_order_.resize(scene.instances.size());
