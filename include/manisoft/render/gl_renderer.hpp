@@ -793,8 +793,7 @@ class GlRenderer {
       for (int k = 0; k < n; ++k) {
         const Eigen::Vector4f clip = view_projection * polygon[static_cast<std::size_t>(k)].homogeneous();
         if (!(clip.w() > 1e-6f)) return whole;
-        pixels.extend(Eigen::Vector2f((clip.x() / clip.w() + 1.0f) * 0.5f * static_cast<float>(width),
-                                      (clip.y() / clip.w() + 1.0f) * 0.5f * static_cast<float>(height)));
+        pixels.extend(clip_to_pixels(clip, width, height));
       }
     }
     return to_pixels(pixels, 1.0f, width, height);
@@ -910,8 +909,7 @@ class GlRenderer {
     Eigen::AlignedBox2f texels;
     for (int c = 0; c < 8 && !box.isEmpty(); ++c) {
       const Eigen::Vector4f p = shadow.view_projection * box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).homogeneous();
-      texels.extend(Eigen::Vector2f((p.x() / p.w() + 1.0f) * 0.5f * static_cast<float>(shadow.window_x),
-                                    (p.y() / p.w() + 1.0f) * 0.5f * static_cast<float>(shadow.window_y)));
+      texels.extend(clip_to_pixels(p, shadow.window_x, shadow.window_y));
     }
     return to_pixels(texels, 2.0f, shadow.limit_x(options_.shadow_map_size), shadow.limit_y(options_.shadow_map_size));
   }
@@ -1183,6 +1181,11 @@ class GlRenderer {
     return box;
   }
 
+  // A clip-space point's position in a width x height viewport, in pixels.
+  static Eigen::Vector2f clip_to_pixels(const Eigen::Vector4f& clip, int width, int height) {
+    return Eigen::Vector2f((clip.x() / clip.w() + 1.0f) * 0.5f * static_cast<float>(width), (clip.y() / clip.w() + 1.0f) * 0.5f * static_cast<float>(height));
+  }
+
   // Framebuffer pixels covering a set of points given in pixel units, `margin` added a side,
   // clamped to [0, width) x [0, height).
   static PixelRect to_pixels(const Eigen::AlignedBox2f& points, float margin, int width, int height) {
@@ -1200,7 +1203,7 @@ class GlRenderer {
     for (int c = 0; c < 8; ++c) {
       const Eigen::Vector4f clip = view_projection * box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).homogeneous();
       if (!(clip.w() > 1e-6f)) return PixelRect{0, 0, width, height};
-      pixels.extend(Eigen::Vector2f((clip.x() / clip.w() + 1.0f) * 0.5f * static_cast<float>(width), (clip.y() / clip.w() + 1.0f) * 0.5f * static_cast<float>(height)));
+      pixels.extend(clip_to_pixels(clip, width, height));
     }
     return to_pixels(pixels, 2.0f, width, height);
   }
