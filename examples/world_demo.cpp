@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "manisoft/control/tool_down.hpp"
 #include "manisoft/rod/inverse_statics.hpp"
 #include "manisoft/rod/settle.hpp"
 #include "manisoft/world/arm_world.hpp"
@@ -99,10 +100,7 @@ double symmetric_uniform(std::mt19937_64& rng) { return 2.0 * double(rng() >> 11
 
 /// The tool-down gripper pose whose grasp centre is at `grasp_center` (closing axis along x).
 math::Pose<double> tool_down(const Vec3& grasp_center, const interaction::ParallelGripperParameters& gp) {
-  math::Pose<double> pose;
-  pose.rotation << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // d1 = +x, d2 = -y, d3 = -z
-  pose.translation = grasp_center + Vec3(0, 0, gp.grasp_center().z());
-  return pose;
+  return control::tool_down_pose(grasp_center, 0.0, gp.grasp_center());
 }
 
 // ---- 1. actuations sampled by the map -----------------------------------------------------------------

@@ -15,6 +15,7 @@
 
 #include "../render/blender_run.hpp"
 #include "../render/spec_render_scene.hpp"
+#include "manisoft/control/action_layout.hpp"
 #include "manisoft/dataset/episode.hpp"
 #include "manisoft/render/gl_renderer.hpp"
 #include "manisoft/task/task_env.hpp"
@@ -38,14 +39,13 @@ class EpisodeImages {
     images.height = height_;
     set_scene(spec, env.library());
     env.reset(spec);
-    const int n = static_cast<int>(e.actions.cols() - 1) / 3;
+    const int n = static_cast<int>(e.actions.cols() - 1) / 3;  // FlatAction::size(n) columns
     manisoft::task::TaskEnv::Array3 torques(n, 3);
     frames_.clear();
     for (long r = 0; r < e.steps(); ++r) {
       if (r % every == 0) add_image(env, images, r);
-      for (int j = 0; j < n; ++j)
-        for (int c = 0; c < 3; ++c) torques(j, c) = e.actions(r, 3 * j + c);
-      env.step(torques, static_cast<int>(e.actions(r, 3 * n)));
+      const int s = manisoft::control::FlatAction::unpack(e.actions.row(r), torques);
+      env.step(torques, s);
     }
     if (blender_) render_with_blender(images);
     return images;

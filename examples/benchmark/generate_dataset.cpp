@@ -72,8 +72,9 @@ struct Plan {
     j["type"] = "manisoft";
     std::vector<std::string> names;
     for (auto t : tasks) names.emplace_back(ms::scene::to_string(t));
+    const ms::task::TaskEnvConfig env;  // the episodes' horizon and control step
     j["env_kwargs"] = {{"tasks", names},       {"clean", clean},  {"randomized", randomized}, {"seed", seed},
-                       {"max_draws", max_draws}, {"horizon", 1500}, {"control_dt", 7 * 2e-4},    {"image_every", image_every},
+                       {"max_draws", max_draws}, {"horizon", env.horizon}, {"control_dt", env.dt * env.substeps},    {"image_every", image_every},
                        {"image_width", image_width}, {"image_height", image_height}};
     return j.dump();
   }

@@ -4,7 +4,9 @@
 // Samples the scene (or reads --scene), prints the instruction and each waypoint as it is
 // reached, and ends its output with one line of JSON:
 //   {"task":..., "setting":..., "index":..., "seed":..., "success":true|false, "steps":N,
-//    "failure":null|"reason", "expert":null|"why it gave up", "cpu_s":...}
+//    "failure":null|"reason", "expert":null|"why it gave up", "cpu_s":..., "object": the target
+//    object's asset id, "relation", "instruction", "unmet": the predicate's conditions that did
+//    not hold at the end}
 // --trace writes one CSV row per control step, step 0 the state after reset, in world_demo's layout
 // (render_scene --scene S --trace T replays it): step, time, phase (the expert's phase: 0 approach,
 // 1 descend, 2 close, 3 carry, 4 lower, 5 open, 6 retract, 7 idle, 8 failed), S, finger width,
@@ -34,7 +36,7 @@ int main(int argc, char** argv) {
   std::uint64_t index = 0, seed = 0;
   bool quiet = false;
   task::ExpertConfig expert_config;
-  app.add_option("--task", task_name, "COLL, ALN, STK or ARR")->check(CLI::IsMember({"COLL", "ALN", "STK", "ARR"}));
+  app.add_option("--task", task_name, "COLL, ALN, STK or ARR")->check(CLI::IsMember(scene::task_names()));
   app.add_option("--setting", setting, "clean or randomized")->check(CLI::IsMember({"clean", "randomized"}));
   app.add_option("--index", index, "scene index (>= 0)");
   app.add_option("--seed", seed, "dataset seed (>= 0)");
@@ -163,8 +165,9 @@ int main(int argc, char** argv) {
     if (!quiet)
       std::printf("%s after %ld control steps (%.2f s simulated), episode CPU %.3f s\n", info.success ? "SUCCESS" : "FAILURE", info.step,
                   double(info.step) * env.control_dt(), episode_cpu);
-    if (!quiet && !info.success) {  // where everything ended: which part of the predicate failed
+    if (!quiet && !info.success) {  // which conditions of the predicate failed, and where everything ended
       const auto snapshot = env.snapshot();
+      std::printf("unmet at the end: %s\n", env.conditions().unmet().c_str());
       std::printf("at the end (gripper %s):\n", snapshot.gripper_open ? "open" : "closed");
       for (std::size_t i = 0; i < snapshot.objects.size(); ++i) {
         const auto& o = snapshot.objects[i];
@@ -176,22 +179,20 @@ int main(int argc, char** argv) {
     const auto quoted = [](std::string_view text) { return nlohmann::json(text).dump(); };  // a JSON string, escaped
     std::string failure = info.success ? "null" : quoted(task::to_string(info.failure));
     std::string why = expert.failure()[0] ? quoted(expert.failure()) : "null";
-    // What the episode was about, for per-category tables: the object moved (COLL, ALN: the goal's
-    // object; ARR: the first relation's) and ARR's first relation.
-    int moved = spec.goal.object;
-    std::string relation = "null";
-    if (!spec.goal.relations.empty()) {
-      const auto& r = spec.goal.relations.front();
-      if (!r.objects.empty()) moved = r.objects.front();
-      relation = quoted(manisoft::geometry::to_string(r.kind));
-    }
-    const std::string object = moved >= 0 ? quoted(spec.objects[static_cast<std::size_t>(moved)].asset_id) : "null";
+    // What the episode was about, for per-category tables: its target object (task::target_object)
+    // and ARR's first relation; which conditions of the predicate did not hold at the end.
+    const int target = task::target_object(spec);
+    const std::string relation = spec.goal.relations.empty() ? "null" : quoted(manisoft::geometry::to_string(spec.goal.relations.front().kind));
+    const std::string object = target >= 0 ? quoted(spec.objects[static_cast<std::size_t>(target)].asset_id) : "null";
+    nlohmann::json unmet = nlohmann::json::array();
+    for (const auto& c : env.conditions())
+      if (!c.holds) unmet.push_back(std::string(c.name));
     std::printf("{\"task\":\"%s\",\"setting\":\"%s\",\"index\":%llu,\"seed\":%llu,\"success\":%s,\"success_at_end\":%s,\"steps\":%ld,\"failure\":%s,"
-                "\"expert\":%s,\"cpu_s\":%.3f,\"episode_cpu_s\":%.3f,\"object\":%s,\"relation\":%s,\"instruction\":%s}\n",
+                "\"expert\":%s,\"cpu_s\":%.3f,\"episode_cpu_s\":%.3f,\"object\":%s,\"relation\":%s,\"instruction\":%s,\"unmet\":%s}\n",
                 std::string(scene::to_string(spec.task)).c_str(), std::string(scene::to_string(spec.setting)).c_str(),
                 static_cast<unsigned long long>(spec.index), static_cast<unsigned long long>(spec.seed), info.success ? "true" : "false",
                 env.success_at_end() ? "true" : "false", info.step, failure.c_str(), why.c_str(), cpu, episode_cpu, object.c_str(),
-                relation.c_str(), quoted(spec.instruction).c_str());
+                relation.c_str(), quoted(spec.instruction).c_str(), unmet.dump().c_str());
   } catch (const manisoft::Error& e) {
     std::fprintf(stderr, "run_task: %s\n", e.what());
     return 1;

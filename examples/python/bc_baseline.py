@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A small learned baseline (issue 16, section 3): behaviour cloning from the camera image and the
+"""A small learned baseline: behaviour cloning from the camera image and the
 instruction to an action chunk, trained on CPU with PyTorch (Debian python3-torch) on expert
 episodes, evaluated by the harness like any policy. It shows the loop end to end; it is not meant to
 compete with the paper's 400M-parameter policies.
@@ -25,7 +25,9 @@ import time
 
 import numpy as np
 
-TASKS = ("COLL", "ALN", "STK", "ARR")
+import manisoft
+
+TASKS = tuple(t["name"] for t in manisoft.tasks())
 
 
 def words(text):
@@ -33,7 +35,6 @@ def words(text):
 
 
 def collect(args):
-    import manisoft
     camera = {"width": args.image_size, "height": args.image_size}
     images, texts, chunks, episodes = [], [], [], []
     t0 = time.perf_counter()

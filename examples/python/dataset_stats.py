@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""dataset_stats DIR [--out OUT]: the paper's figure 4 for a ManiSoft dataset (issue 15), from the
-files alone (h5py, numpy, matplotlib): trajectory length histogram per task (lengths.png), target
+"""dataset_stats DIR [--out OUT]: the paper's figure 4 for a ManiSoft dataset, from the
+files (h5py, numpy, matplotlib; the task list and target objects from the manisoft module): trajectory length histogram per task (lengths.png), target
 object category frequency (categories.png), heat map of the target objects' initial positions on
 the table (heatmap.png), instruction length in words (instructions.png), and stats.md, a Markdown
 table per task and setting (episodes, mean / median / max steps). OUT defaults to DIR/stats."""
@@ -16,14 +16,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 
-
-def target_object(scene):
-    goal = scene["goal"]
-    if scene["task"] in ("COLL", "ALN"):
-        return goal["object"]
-    if scene["task"] == "ARR":
-        return goal["relations"][0]["objects"][0]
-    return goal["items"][-1]  # STK: the first item moved (on top of the stack)
+import manisoft  # noqa: E402
 
 
 def read(directory):
@@ -33,7 +26,7 @@ def read(directory):
             demo = f["data"][name]
             a = demo.attrs
             scene = json.loads(a["scene"])
-            obj = scene["objects"][target_object(scene)]
+            obj = scene["objects"][manisoft.target_object(a["scene"])]
             instructions = [a["instruction"]] + json.loads(a["instructions_seen"]) + json.loads(a["instructions_unseen"])
             rows.append({"task": a["task"], "setting": a["setting"], "steps": int(a["num_samples"]),
                          "category": obj["asset_id"].split("/")[0], "position": obj["pose"]["position"][:2],
@@ -49,10 +42,11 @@ def main():
     out = args.out or os.path.join(args.dir, "stats")
     os.makedirs(out, exist_ok=True)
     rows = read(args.dir)
-    tasks = sorted({r["task"] for r in rows}, key=["COLL", "ALN", "STK", "ARR"].index)
+    order = [t["name"] for t in manisoft.tasks()]
+    tasks = sorted({r["task"] for r in rows}, key=order.index)
 
     fig, ax = plt.subplots(figsize=(6, 4))
-    bins = np.linspace(0, 1500, 31)
+    bins = np.linspace(0, manisoft.HORIZON, 31)
     ax.hist([[r["steps"] for r in rows if r["task"] == t] for t in tasks], bins=bins, label=tasks, stacked=True)
     ax.set(xlabel="trajectory length (control steps)", ylabel="episodes", title="(a) trajectory lengths per task")
     ax.legend()

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Evaluates a policy on ManiSoft's held-out scenes and writes the paper's tables (issue 16, section 2).
+"""Evaluates a policy on ManiSoft's held-out scenes and writes the paper's tables.
 
     PYTHONPATH=build/<config>/python /usr/bin/python3 examples/python/evaluate.py \\
         --task all --setting clean --policy expert --episodes-per-category 20 --seed 0 --out eval/expert
@@ -18,7 +18,7 @@ Policies (--policy):
 A chunk's first --chunk-steps actions are executed before the policy is asked again.
 
 Scenes: the evaluation split (never drawn by dataset generation), eval indices 0, 1, 2, ... of each
-task and setting, the first K of each target-object category (STK: K in all); horizon T = 1500.
+task and setting, the first K of each target-object category (STK: K in all); horizon T = manisoft.HORIZON (1500).
 Episodes alternate seen and unseen instructions where the scene has them (randomized scenes).
 A policy that raises, returns a malformed action or is slower than --policy-timeout seconds fails
 the episode with that reason; the evaluation goes on.
@@ -44,9 +44,12 @@ from collections import Counter, defaultdict
 
 import numpy as np
 
-TASKS = ("COLL", "ALN", "STK", "ARR")
+import manisoft
+
+TASKS = tuple(t["name"] for t in manisoft.tasks())
+BY_CATEGORY = {t["name"]: t["by_category"] for t in manisoft.tasks()}
 SETTINGS = ("clean", "randomized")
-HORIZON = 1500
+HORIZON = manisoft.HORIZON
 
 
 # ---- statistics
@@ -64,16 +67,13 @@ def wilson_interval(successes, n, z=1.959963984540054):
 
 # ---- scenes
 
-def target_category(scene):
-    """The category of a scene's designated object ("bottle" of "bottle/05"); STK: its bottom item's."""
-    goal, objects = scene["goal"], scene["objects"]
-    if scene["task"] in ("COLL", "ALN"):
-        index = goal["object"]
-    elif scene["task"] == "ARR":
-        index = goal["relations"][0]["objects"][0]
-    else:
+def target_category(scene_text):
+    """The category of a scene's target object ("bottle" of "bottle/05", manisoft.target_object);
+    "all" for a task whose episodes are not grouped by category (manisoft.tasks()'s by_category)."""
+    scene = json.loads(scene_text)
+    if not BY_CATEGORY[scene["task"]]:
         return "all"
-    return objects[index]["asset_id"].split("/")[0]
+    return scene["objects"][manisoft.target_object(scene_text)]["asset_id"].split("/")[0]
 
 
 def plan_episodes(task, setting, per_category, seed, max_scan, sampler):
@@ -82,7 +82,7 @@ def plan_episodes(task, setting, per_category, seed, max_scan, sampler):
     category met has its episodes and the last max(30, 4 per_category) indices brought no new one."""
     counts, plan, last_new = Counter(), [], 0
     for index in range(max_scan):
-        category = target_category(json.loads(sampler.sample(task, setting, index, seed, "eval")))
+        category = target_category(sampler.sample(task, setting, index, seed, "eval"))
         if category not in counts:
             last_new = index
         if counts[category] < per_category:
@@ -270,7 +270,6 @@ class Worker:
         self.current = None
 
     def env(self, task, setting):
-        import manisoft
         key = (task, setting)
         if key not in self.envs:
             width, height = self.args.image_size
@@ -471,14 +470,13 @@ def main(argv=None):
     if args.save_actions:
         os.makedirs(os.path.join(args.out, "actions"), exist_ok=True)
     t0 = time.perf_counter()
-    import manisoft
     sampler = manisoft.SceneSampler()
     plan = []
     for setting in args.settings:
         k = args.episodes_per_category or (20 if setting == "clean" else 40)
         for task in args.tasks:
             if args.indices:
-                plan += [(task, setting, i, target_category(json.loads(sampler.sample(task, setting, i, args.seed, "eval")))) for i in args.indices]
+                plan += [(task, setting, i, target_category(sampler.sample(task, setting, i, args.seed, "eval"))) for i in args.indices]
             else:
                 plan += plan_episodes(task, setting, k, args.seed, args.max_scan or 60 * k, sampler)
     episodes_in = [p + (n,) for n, p in enumerate(plan)]

@@ -34,6 +34,7 @@ namespace {
 
 using Env = manisoft::env::ReachEnv<>;  // PyElastica's analytical damping, element torques
 using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+const int task_horizon = manisoft::task::TaskEnvConfig{}.horizon;  ///< the tasks' T
 
 py::array_t<double> to_numpy(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>& m) {
   py::array_t<double> out({m.rows(), m.cols()});
@@ -263,15 +264,52 @@ PYBIND11_MODULE(manisoft, m) {
       [](const std::string& name, const std::string& setting, std::uint64_t seed, bool render, const std::optional<py::dict>& camera,
          bool privileged, const std::string& split, const std::string& target_set, int horizon) -> py::object {
         if (name == "reach") return py::cast(std::make_unique<ReachEnvironment>(target_set, seed, horizon));
-        if (name != "COLL" && name != "ALN" && name != "STK" && name != "ARR")
-          throw py::value_error("make_env: unknown environment '" + name + "' (available: COLL, ALN, STK, ARR, reach)");
-        if (horizon != 1500) throw py::value_error("make_env: the tasks' horizon is the paper's T = 1500");
+        std::string names;
+        bool known = false;
+        for (const auto t : manisoft::scene::all_tasks) {
+          known = known || name == manisoft::scene::to_string(t);
+          names += std::string(manisoft::scene::to_string(t)) + ", ";
+        }
+        if (!known) throw py::value_error("make_env: unknown environment '" + name + "' (available: " + names + "reach)");
+        if (horizon != task_horizon)
+          throw py::value_error("make_env: the tasks' horizon is the paper's T = " + std::to_string(task_horizon) + " (got " + std::to_string(horizon) + ")");
         return py::cast(std::make_unique<TaskEnvironment>(name, setting, seed, render, camera, privileged, split));
       },
       py::arg("name"), py::arg("setting") = "clean", py::arg("seed") = 0, py::arg("render") = false, py::arg("camera") = py::none(),
-      py::arg("privileged") = false, py::arg("split") = "train", py::arg("target_set") = "table", py::arg("horizon") = 1500,
-      "Makes an environment: make_env('COLL'|'ALN'|'STK'|'ARR', 'clean'|'randomized', seed=0, render=False, camera=None, "
-      "privileged=False, split='train'), or make_env('reach', target_set='table'|'equilibria', seed=0, horizon=1500)");
+      py::arg("privileged") = false, py::arg("split") = "train", py::arg("target_set") = "table", py::arg("horizon") = task_horizon,
+      "Makes an environment: make_env(task, 'clean'|'randomized', seed=0, render=False, camera=None, privileged=False, split='train') "
+      "for a task of manisoft.tasks(), or make_env('reach', target_set='table'|'equilibria', seed=0, horizon=HORIZON)");
+  // The tasks and the episode's timing, from the one definition of each (task/registry.hpp, TaskEnvConfig).
+  m.def(
+      "tasks",
+      [] {
+        py::list out;
+        for (const auto t : manisoft::scene::all_tasks) {
+          const auto info = manisoft::task::task_info(t);
+          py::dict d;
+          d["name"] = std::string(info.name);
+          d["summary"] = std::string(info.summary);
+          py::list conditions;
+          for (const auto c : info.conditions) conditions.append(std::string(c));
+          d["conditions"] = conditions;
+          d["by_category"] = info.tables_by_category;
+          out.append(d);
+        }
+        return out;
+      },
+      "The benchmark's tasks in order: [{'name', 'summary', 'conditions', 'by_category'}] (success: every condition holds; "
+      "by_category: evaluation plans and tables per target-object category)");
+  m.attr("HORIZON") = task_horizon;
+  m.attr("CONTROL_DT") = manisoft::task::TaskEnvConfig{}.dt * manisoft::task::TaskEnvConfig{}.substeps;
+  m.def(
+      "target_object",
+      [](const std::string& scene_json) {
+        const auto spec = manisoft::scene::parse_scene(scene_json, "target_object scene");
+        return manisoft::task::target_object(spec);
+      },
+      py::arg("scene"),
+      "The index of the object a scene's episode is about (COLL, ALN: the goal's object; STK: the top item; ARR: the first relation's "
+      "placed object), -1 when none");
   py::class_<manisoft::scene::SceneSampler>(m, "SceneSampler", "The benchmark's scenes (assets, layouts, instructions), drawn deterministically")
       .def(py::init<>())
       .def(

@@ -1,4 +1,4 @@
-// The benchmark's task environment for Python (issue 16, section 1): task::TaskEnv (one ManiSoft
+// The benchmark's task environment for Python: task::TaskEnv (one ManiSoft
 // task COLL/ALN/STK/ARR in the arm world, success predicate, failure reasons) with scenes from
 // scene::SceneSampler, the camera image from the in-process OpenGL renderer (render::GlRenderer
 // over examples/render/spec_render_scene.hpp), and the rule-based expert (task::Expert) for
@@ -12,8 +12,9 @@
 // step, handed over without a copy); with privileged=True also "end_effector" (4 x 4, the rod tip's
 // frame), "gripper_pose" (4 x 4, the gripper body: what Renderer.render takes), "rod_nodes" ((n+1) x 3), "gripper_width" (m), "gripper_state" (S), "object_poses"
 // (objects x 4 x 4, asset frame -> world).
-// Reward: 1 at the step the task succeeds, else 0. terminated: success or a terminal failure
-// (diverged, object_off_table, scene_invalid); truncated: the horizon (T = 1500) reached.
+// Reward: 1 at the step the task succeeds, else 0. terminated / truncated as TaskEnv's StepInfo
+// says (success or a terminal failure / the horizon). info["conditions"]: the success
+// predicate's named conditions at this step.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -27,6 +28,7 @@
 #include <vector>
 
 #include "../render/spec_render_scene.hpp"
+#include "manisoft/control/action_layout.hpp"
 #include "manisoft/render/gl_renderer.hpp"
 #include "manisoft/scene/scene_json.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
@@ -137,6 +139,7 @@ inline std::unique_ptr<ms::render::GlRenderer> make_policy_renderer() {
 class TaskEnvironment {
  public:
   using Array3 = ms::task::TaskEnv::Array3;
+  using Action = ms::control::FlatAction;
 
   TaskEnvironment(const std::string& task, const std::string& setting, std::uint64_t seed, bool render, const std::optional<py::dict>& camera,
                   bool privileged, const std::string& split)
@@ -206,11 +209,7 @@ class TaskEnvironment {
       env_.step(torques_, s);
     }
     const auto& i = env_.info();
-    const bool terminal_failure = i.done && !i.success && i.failure != ms::task::FailureReason::timeout &&
-                                  i.failure != ms::task::FailureReason::object_dropped && i.failure != ms::task::FailureReason::arm_hit_obstacle;
-    const bool terminated = i.success || terminal_failure;
-    const bool truncated = i.done && !terminated;
-    return py::make_tuple(observation(), i.success ? 1.0 : 0.0, terminated, truncated, info());
+    return py::make_tuple(observation(), i.success ? 1.0 : 0.0, i.terminated, i.truncated, info());
   }
 
   /// The expert's action for the current state (privileged: it reads the world).
@@ -221,11 +220,8 @@ class TaskEnvironment {
       py::gil_scoped_release release;
       expert_.act(torques_, s);
     }
-    py::array_t<double> out(3 * n_ + 1);
-    auto v = out.mutable_unchecked<1>();
-    for (int k = 0; k < n_; ++k)
-      for (int c = 0; c < 3; ++c) v(3 * k + c) = torques_(k, c);
-    v(3 * n_) = s;
+    py::array_t<double> out(Action::size(n_));
+    Action::pack(torques_, s, out.mutable_unchecked<1>());
     return out;
   }
 
@@ -239,18 +235,18 @@ class TaskEnvironment {
 
   py::dict action_space() const {
     const ms::rod::ActuationLimits<double> lim = ms::world::ArmWorldSettings{}.limits;  // TaskEnv's world keeps the defaults
-    py::array_t<double> low(3 * n_ + 1), high(3 * n_ + 1);
+    py::array_t<double> low(Action::size(n_)), high(Action::size(n_));
     auto l = low.mutable_unchecked<1>();
     auto h = high.mutable_unchecked<1>();
     for (int k = 0; k < n_; ++k)
       for (int c = 0; c < 3; ++c) {
-        h(3 * k + c) = k == 0 ? 0.0 : lim.limit(c);
-        l(3 * k + c) = -h(3 * k + c);
+        h(Action::torque(k, c)) = k == 0 ? 0.0 : lim.limit(c);
+        l(Action::torque(k, c)) = -h(Action::torque(k, c));
       }
-    l(3 * n_) = 0.0;
-    h(3 * n_) = 1.0;
+    l(Action::gripper(n_)) = 0.0;
+    h(Action::gripper(n_)) = 1.0;
     py::dict d;
-    d["shape"] = py::make_tuple(3 * n_ + 1);
+    d["shape"] = py::make_tuple(Action::size(n_));
     d["dtype"] = "float64";
     d["low"] = low;
     d["high"] = high;
@@ -303,19 +299,15 @@ class TaskEnvironment {
     const char kind = action.dtype().kind();
     if (kind != 'f' && kind != 'i' && kind != 'u')
       throw py::value_error("step: action dtype must be real (float64 preferred), got " + std::string(py::str(action.dtype())));
-    if (action.ndim() != 1 || action.shape(0) != 3 * n_ + 1)
-      throw py::value_error("step: action must have shape (" + std::to_string(3 * n_ + 1) + ",) (n x 3 torques then S), got " +
+    if (action.ndim() != 1 || action.shape(0) != Action::size(n_))
+      throw py::value_error("step: action must have shape (" + std::to_string(Action::size(n_)) + ",) (n x 3 torques then S), got " +
                             std::string(py::str(py::handle(action).attr("shape"))));
     const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(action);
     const auto v = values.unchecked<1>();
     for (py::ssize_t i = 0; i < v.shape(0); ++i)
       if (!std::isfinite(v(i)))
-        throw py::value_error("step: action entry " + std::to_string(i) +
-                              (i < 3 * n_ ? " (element " + std::to_string(i / 3) + ", component d" + std::to_string(i % 3 + 1) + ")" : std::string(" (S)")) +
-                              " is not finite");
-    for (int k = 0; k < n_; ++k)
-      for (int c = 0; c < 3; ++c) torques(k, c) = v(3 * k + c);
-    return v(3 * n_) >= 0.5 ? 1 : 0;
+        throw py::value_error("step: action entry " + std::to_string(i) + " (" + Action::describe(static_cast<int>(i), n_) + ") is not finite");
+    return Action::unpack(v, torques);
   }
 
   std::vector<ms::math::Pose<double>> object_poses() const {
@@ -375,6 +367,9 @@ class TaskEnvironment {
     d["steps"] = i.step;
     d["done"] = i.done;
     d["failure"] = i.done && !i.success ? py::object(py::str(std::string(ms::task::to_string(i.failure)))) : py::object(py::none());
+    py::dict conditions;  // the predicate's named conditions at this step (success: all hold)
+    for (const auto& c : env_.conditions()) conditions[py::str(std::string(c.name))] = c.holds;
+    d["conditions"] = conditions;
     d["clamped"] = i.clamped;
     d["task"] = std::string(ms::scene::to_string(spec_.task));
     d["setting"] = std::string(ms::scene::to_string(spec_.setting));

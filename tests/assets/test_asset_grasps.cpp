@@ -134,14 +134,6 @@ Pose<double> at(double x, double y, double z) { return Pose<double>{Eigen::Matri
 
 }  // namespace
 
-TEST_CASE("the catalogue's grasp gripper is the world's parallel gripper", "[assets][grasp]") {
-  const manisoft::assets::GraspGripper gg;
-  const interaction::ParallelGripperParameters gp;
-  CHECK(gg.palm_thickness == gp.palm_thickness);
-  CHECK(gg.finger_length == gp.finger_length);
-  CHECK(gg.open_width == gp.open_width);
-}
-
 TEST_CASE("every grasp annotation closes the gripper on its object on the table", "[assets][grasp]") {
   const interaction::ParallelGripperParameters gp;
   const manisoft::assets::GraspGripper gg;

@@ -66,6 +66,8 @@ class TaskEnvTest(unittest.TestCase):
         self.assertFalse(truncated)
         self.assertIsNone(info["failure"])
         self.assertLessEqual(info["steps"], 1500)
+        # Success is every named condition of ALN's predicate holding.
+        self.assertEqual(info["conditions"], {"position": True, "orientation": True, "released": True, "at_rest": True})
         self.assertEqual(sum(rewards), 1.0)
         self.assertEqual(rewards[-1], 1.0)
         with self.assertRaisesRegex(RuntimeError, "episode is over"):
@@ -83,6 +85,31 @@ class TaskEnvTest(unittest.TestCase):
         self.assertTrue(truncated)
         self.assertFalse(terminated)
         self.assertEqual(info["failure"], "timeout")
+        # The arm never moved the object: it is far from its goal pose, released and at rest.
+        self.assertFalse(info["conditions"]["position"])
+        self.assertTrue(info["conditions"]["released"])
+
+    def test_the_registry_defines_tasks_horizon_and_control_step(self):
+        tasks = manisoft.tasks()
+        self.assertEqual([t["name"] for t in tasks], ["COLL", "ALN", "STK", "ARR"])
+        coll = tasks[0]
+        self.assertEqual(coll["conditions"], ["inside", "touching_container", "off_table", "released", "at_rest"])
+        self.assertEqual([t["by_category"] for t in tasks], [True, True, False, True])
+        self.assertEqual(manisoft.HORIZON, 1500)
+        self.assertEqual(manisoft.CONTROL_DT, 7 * 2e-4)  # 7 substeps of 0.2 ms
+        for t in tasks:
+            env = manisoft.make_env(t["name"], "clean", seed=0)
+            _, info = env.reset(options={"index": 0})
+            self.assertEqual(list(info["conditions"]), t["conditions"])
+            self.assertEqual(env.horizon, manisoft.HORIZON)
+        # The target object: COLL / ALN the goal's object, STK the top item, ARR the first placed object.
+        sampler = manisoft.SceneSampler()
+        for name, pick in (("COLL", lambda g: g["object"]), ("STK", lambda g: g["items"][-1]),
+                           ("ARR", lambda g: g["relations"][0]["objects"][0])):
+            text = sampler.sample(name, "clean", 2, 0)
+            self.assertEqual(manisoft.target_object(text), pick(json.loads(text)["goal"]), name)
+        with self.assertRaisesRegex(ValueError, "unknown environment 'PUSH' \\(available: COLL, ALN, STK, ARR, reach\\)"):
+            manisoft.make_env("PUSH")
 
     def test_same_seed_same_episode_and_actions_replay_bit_for_bit(self):
         env = manisoft.make_env("ARR", "randomized", seed=4, privileged=True)

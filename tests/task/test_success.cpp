@@ -1,4 +1,4 @@
-// The four tasks' success predicates (include/manisoft/task/success.hpp) on hand-built states:
+// The four tasks' success predicates (include/manisoft/task/: coll, aln, stk, arr) on hand-built states:
 // each holds where the definition says it must, and fails just outside every tolerance, while an
 // object is still held or moving, and for the wrong order or side.
 #include <catch2/catch.hpp>
@@ -8,7 +8,7 @@
 #include <numbers>
 #include <vector>
 
-#include "manisoft/task/success.hpp"
+#include "manisoft/task/registry.hpp"
 
 namespace test_success {  // per-file namespace: the group's tests build as one unity translation unit
 
@@ -94,7 +94,63 @@ TEST_CASE("COLL: centre of mass inside the receptacle, touching it and not the t
     objects[0].center_of_mass = world_of(Vector3d(0.095, -0.041, -0.05));
     CHECK_FALSE(task::collected(snap(objects), 0, 1, receptacle));
   }
+  SECTION("each failing state names the one condition it breaks") {
+    const task::Coll::Goal goal{0, 1, receptacle};
+    const auto unmet = [&](bool open = true) { return task::Coll::evaluate(snap(objects, open), goal).unmet(); };
+    CHECK(unmet().empty());
+    objects[0].held = true;
+    CHECK(unmet(false) == "released");
+    objects[0].held = false;
+    objects[0].touches_table = true;
+    CHECK(unmet() == "off_table");
+    objects[0].touches_table = false;
+    objects[0].center_of_mass = world_of(Vector3d(0, 0, -0.081));
+    objects[0].touching = 0;
+    CHECK(unmet() == "inside, touching_container");
+    objects[1].angular_velocity = Vector3d(0.11, 0, 0);
+    CHECK(unmet() == "inside, touching_container, at_rest");
+    // At the start of an episode only the position is judged: already inside is no task.
+    CHECK_FALSE(task::Coll::holds_at_start(snap(objects), goal));
+    objects[0].center_of_mass = world_of(Vector3d(0.03, 0.0, -0.05));
+    CHECK(task::Coll::holds_at_start(snap(objects), goal));
+  }
   CHECK_THROWS_WITH(task::collected(snap(objects), 0, 2, receptacle), Catch::Contains("object index 2 is out of range"));
+}
+
+TEST_CASE("registry: every task by name, its conditions as its predicate lists them", "[tasks]") {
+  namespace scene = manisoft::scene;
+  REQUIRE(scene::all_tasks.size() == 4);
+  const std::array<const char*, 4> names{"COLL", "ALN", "STK", "ARR"};
+  for (std::size_t k = 0; k < scene::all_tasks.size(); ++k) {
+    const task::TaskInfo info = task::task_info(scene::all_tasks[k]);
+    CHECK(info.name == names[k]);
+    CHECK(scene::parse_task(names[k]) == scene::all_tasks[k]);
+    CHECK_FALSE(info.summary.empty());
+    CHECK(info.conditions.back() == "at_rest");
+  }
+  // The names evaluate() reports are the ones the registry lists, in order (STK on a hand-built
+  // two-item stack whose top item still moves).
+  std::vector<task::ObjectState> objects{object_at(Vector3d(0.5, 0, 0.76)), object_at(Vector3d(0.5, 0.01, 0.79))};
+  objects[0].touches_table = true;
+  set_contact(objects, 0, 1);
+  objects[1].linear_velocity = Vector3d(0, 0, 0.5);
+  const std::array<int, 2> items{0, 1};
+  const task::Conditions c = task::Stk::evaluate(snap(objects), items);
+  std::vector<std::string_view> reported;
+  for (const auto& condition : c) reported.push_back(condition.name);
+  CHECK(reported == task::task_info(scene::Task::stk).conditions);
+  CHECK(c.unmet() == "at_rest");
+  // The episode's target object: the goal's object, the top of the stack, the first placed object.
+  scene::SceneSpec spec;
+  spec.task = scene::Task::stk;
+  spec.goal.items = {2, 0, 1};
+  CHECK(task::target_object(spec) == 1);
+  spec.task = scene::Task::aln;
+  spec.goal.object = 3;
+  CHECK(task::target_object(spec) == 3);
+  spec.task = scene::Task::arr;
+  spec.goal.relations.push_back(scene::Relation{scene::Relation::Kind::left_of, {4}, {0}, {}});
+  CHECK(task::target_object(spec) == 4);
 }
 
 TEST_CASE("ALN: position within 2 cm, orientation within 0.2 rad modulo the object's symmetry", "[tasks]") {
@@ -181,9 +237,14 @@ TEST_CASE("ARR: relations in the viewer's words with their margins", "[tasks]") 
   std::vector<task::ObjectState> objects{object_at(Vector3d(0.5, -0.15, 0.8)), object_at(Vector3d(0.52, 0.0, 0.8)),
                                          object_at(Vector3d(0.5, 0.15, 0.8)), object_at(Vector3d(0.5, 0.30, 0.8))};
   using Kind = task::Relation::Kind;
-  const auto holds = [&](Kind kind, std::array<int, 4> who) {
-    return task::relation_holds(snap(objects), task::Relation{kind, who});
+  const auto relation = [](Kind kind, std::array<int, 4> who) {  // who[0] placed, then the references until -1
+    task::Relation r;
+    r.kind = kind;
+    r.objects = {who[0]};
+    for (std::size_t k = 1; k < who.size() && who[k] >= 0; ++k) r.references.push_back(who[k]);
+    return r;
   };
+  const auto holds = [&](Kind kind, std::array<int, 4> who) { return task::Arr::relation_holds(snap(objects), relation(kind, who)); };
   CHECK(holds(Kind::left_of, {0, 1, -1, -1}));   // 15 cm to the viewer's left, 2 cm across
   CHECK_FALSE(holds(Kind::right_of, {0, 1, -1, -1}));
   CHECK(holds(Kind::right_of, {1, 0, -1, -1}));
@@ -211,8 +272,7 @@ TEST_CASE("ARR: relations in the viewer's words with their margins", "[tasks]") 
   // arranged(): relations hold and every named object is released and at rest.
   objects[0].center_of_mass = Vector3d(0.5, -0.15, 0.8);
   objects[1].center_of_mass = Vector3d(0.52, 0.0, 0.8);
-  const std::array<task::Relation, 2> goal{task::Relation{Kind::left_of, {0, 1, -1, -1}},
-                                           task::Relation{Kind::right_of, {2, 1, -1, -1}}};
+  const std::array<task::Relation, 2> goal{relation(Kind::left_of, {0, 1, -1, -1}), relation(Kind::right_of, {2, 1, -1, -1})};
   CHECK(task::arranged(snap(objects), goal));
   objects[2].held = true;
   CHECK_FALSE(task::arranged(snap(objects), goal));

@@ -95,6 +95,8 @@ TEST_CASE("COLL: a cup released over the basket's opening falls in and the episo
   REQUIRE_FALSE(e.done());
   hold_home(e);
   CHECK(e.info().success);
+  CHECK(e.info().terminated);
+  CHECK(e.conditions().all());
   CHECK(e.info().failure == FailureReason::none);
   CHECK(e.success_at_end());
   // Fall of 2 cm + the depth below the rim plus settling, then hold_steps at rest: well within 0.5 s.
@@ -145,8 +147,7 @@ TEST_CASE("bodies at rest sleep after the task world's time_to_sleep and still r
 TEST_CASE("episodes end for the documented reasons: goal already met, object off the table, horizon", "[tasks][env]") {
   TaskEnv& e = env();
   SECTION("a goal that holds at reset is an invalid scene: done before the first step") {
-    // ALN with the object standing at its goal pose (contacts are known only after a step, so
-    // this is checked for the position-only goals: ALN and ARR).
+    // ALN with the object standing at its goal pose.
     SceneSpec s = sample(Task::aln, 1);
     s.objects.at(static_cast<std::size_t>(s.goal.object)).pose = s.goal.goal_pose;
     e.reset(s);
@@ -154,8 +155,30 @@ TEST_CASE("episodes end for the documented reasons: goal already met, object off
     CHECK(e.info().step == 0);
     CHECK_FALSE(e.info().success);
     CHECK(e.info().failure == FailureReason::scene_invalid);
+    CHECK(e.info().terminated);
+    CHECK_FALSE(e.info().truncated);
     TaskEnv::Array3 zero = TaskEnv::Array3::Zero(e.arm_model().rod.n_elements, 3);
     CHECK_THROWS_AS(e.step(zero, 0), manisoft::Error);
+  }
+  SECTION("COLL with the object already in its container, STK already stacked: invalid too") {
+    // The cup at the basket's placement point (inside, below the rim): contacts are not known
+    // before a step, so the position alone decides.
+    SceneSpec coll = sample(Task::coll, 3);
+    coll.objects.at(static_cast<std::size_t>(coll.goal.object)).pose.translation = container_placement(coll).translation;
+    e.reset(coll);
+    CHECK(e.info().failure == FailureReason::scene_invalid);
+    CHECK(e.conditions().holds("inside"));
+    // The stack's items one above the other at the bottom item's place, 3 cm apart in height.
+    SceneSpec stk = sample(Task::stk, 0);
+    const Eigen::Vector3d bottom = stk.objects.at(static_cast<std::size_t>(stk.goal.items.front())).pose.translation;
+    for (std::size_t k = 1; k < stk.goal.items.size(); ++k)
+      stk.objects.at(static_cast<std::size_t>(stk.goal.items[k])).pose.translation = bottom + Eigen::Vector3d(0, 0, 0.03 * double(k));
+    e.reset(stk);
+    CHECK(e.info().failure == FailureReason::scene_invalid);
+    // The sampled scenes themselves are tasks.
+    e.reset(sample(Task::stk, 0));
+    CHECK_FALSE(e.done());
+    CHECK_FALSE(e.conditions().all());
   }
   SECTION("a cup placed beyond the table's front edge falls off: object_off_table") {
     // table top x in [0, 0.8]: 5 cm beyond the edge, 1 cm above the top
@@ -163,6 +186,7 @@ TEST_CASE("episodes end for the documented reasons: goal already met, object off
     hold_home(e);
     CHECK_FALSE(e.info().success);
     CHECK(e.info().failure == FailureReason::object_off_table);
+    CHECK(e.info().terminated);
     CHECK(e.info().step < 400);  // a free fall below the top takes ~0.05 s
   }
   SECTION("nothing done: the horizon ends the episode with a timeout") {
@@ -173,6 +197,10 @@ TEST_CASE("episodes end for the documented reasons: goal already met, object off
     hold_home(shorter);
     CHECK(shorter.info().step == 40);
     CHECK(shorter.info().failure == FailureReason::timeout);
+    CHECK(shorter.info().truncated);
+    CHECK_FALSE(shorter.info().terminated);
+    // The explanation: the cup still stands on the table, away from the basket.
+    CHECK(shorter.conditions().unmet() == "inside, touching_container, off_table");
   }
 }
 

@@ -43,6 +43,20 @@ inline const char* to_string(SizeClass s) {
   return "?";
 }
 
+/// The ManiSoft parallel gripper's dimensions: the one definition the grasp annotations
+/// (catalog.hpp), the mesh importer's grasps and the simulated gripper
+/// (interaction::ParallelGripperParameters) take.
+struct GraspGripper {
+  double palm_thickness = 0.05;    ///< m, attachment frame to the fingers' root
+  double finger_length = 0.07;     ///< m
+  double open_width = 0.10;        ///< m, between the inner finger faces
+  double palm_clearance = 0.005;   ///< m, palm above the object's top (annotated grasps)
+  double table_clearance = 0.01;   ///< m, fingertips above the support plane (annotated grasps)
+
+  /// Gripper origin to the contact point along the approach axis: the fingers' middle.
+  double grasp_depth() const { return palm_thickness + 0.5 * finger_length; }
+};
+
 /// A named visible part (body, cap, handle, label): mesh in the asset frame and its look.
 struct VisualPart {
   std::string name;

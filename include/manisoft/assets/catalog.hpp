@@ -13,8 +13,8 @@
 // container as large as a storage basket (20-28 cm square, 7-9 cm tall: every COLL category
 // has instances that stand in one with their centre of mass below the rim) and has no grasp.
 // Grasps (one per graspable object, tool-down, closing along the asset's x axis) are made for the
-// ManiSoft parallel gripper (GraspGripper restates interaction::ParallelGripperParameters' defaults: this
-// layer sits above interaction; tests/assets/test_asset_grasps.cpp checks that they agree): the
+// ManiSoft parallel gripper (GraspGripper, asset.hpp: the dimensions interaction::ParallelGripperParameters
+// takes its defaults from): the
 // palm stops palm_clearance above the object's top, but never so low that the fingertips come
 // closer than table_clearance to the support plane (flat objects: plate, bowl, Rubik's cube);
 // the annotated width is the object's extent along the closing axis over the fingers' height
@@ -35,15 +35,6 @@
 #include "manisoft/render/mesh_builders.hpp"
 
 namespace manisoft::assets {
-
-/// The gripper the grasp annotations are made for (see the header comment).
-struct GraspGripper {
-  double palm_thickness = 0.05;    ///< m, attachment frame to the fingers' root
-  double finger_length = 0.07;     ///< m
-  double open_width = 0.10;        ///< m, between the inner finger faces
-  double palm_clearance = 0.005;   ///< m, palm above the object's top
-  double table_clearance = 0.01;   ///< m, fingertips above the support plane
-};
 
 namespace catalog_detail {
 

@@ -69,10 +69,10 @@ struct ImportOptions {
   geometry::DecompositionOptions decomposition{};
   double max_size = 10.0;            ///< m, largest accepted bounding-box extent after scaling
   double min_size = 1e-3;            ///< m, smallest accepted largest extent
-  double grasp_depth = 0.085;        ///< m, gripper origin to contact point along +z (palm 0.05 + half finger 0.035)
+  double grasp_depth = GraspGripper{}.grasp_depth();  ///< m, gripper origin to contact point along +z
   double approach_distance = 0.10;   ///< m, approach pose backed off along the grasp frame's -z
   double lift_height = 0.10;         ///< m, lift pose above the grasp (asset +z)
-  double gripper_open_width = 0.10;  ///< m, grasp widths are clamped below this
+  double gripper_open_width = GraspGripper{}.open_width;  ///< m, grasp widths are clamped below this
   std::uintmax_t max_file_bytes = std::uintmax_t{1} << 30;
 };
 

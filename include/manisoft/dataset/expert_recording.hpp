@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "manisoft/control/action_layout.hpp"
 #include "manisoft/dataset/episode.hpp"
 #include "manisoft/scene/scene_json.hpp"
 #include "manisoft/task/task_env.hpp"
@@ -59,7 +60,7 @@ class EpisodeRecorder {
     const int n = env.arm_model().rod.n_elements;
     const int objects = static_cast<int>(env.spec().objects.size());
     const long t = env.config().horizon;
-    e_.actions.resize(t, 3 * n + 1);
+    e_.actions.resize(t, control::FlatAction::size(n));
     e_.states.resize(t, state_columns(n, objects));
     eef_.resize(t, 7);
     gripper_.resize(t, 2);
@@ -73,9 +74,7 @@ class EpisodeRecorder {
   void step(const Matrix& torques, int s) {
     if (rows_ >= e_.actions.rows()) manisoft::detail::fail("EpisodeRecorder: more steps than the horizon (", e_.actions.rows(), ")");
     const long r = rows_++;
-    for (Eigen::Index k = 0; k < torques.rows(); ++k)
-      for (int c = 0; c < 3; ++c) e_.actions(r, 3 * k + c) = torques(k, c);
-    e_.actions(r, e_.actions.cols() - 1) = s;
+    control::FlatAction::pack(torques, s, e_.actions.row(r));
     read_state(*env_, e_.states.row(r));
     const auto f = env_->world().soft().end_effector_frame();
     const Eigen::Quaterniond q(f.rotation);
@@ -137,8 +136,8 @@ inline long replay_mismatch(task::TaskEnv& env, const Episode& episode) {
   if (scene_text == episode.text.end()) manisoft::detail::fail("replay: episode ", episode.index, " has no scene attribute");
   env.reset(scene::parse_scene(scene_text->second, "episode " + std::to_string(episode.index) + " scene"));
   const int n = env.arm_model().rod.n_elements;
-  if (episode.actions.cols() != 3 * n + 1)
-    manisoft::detail::fail("replay: episode ", episode.index, " actions have ", episode.actions.cols(), " columns, the arm needs ", 3 * n + 1);
+  if (episode.actions.cols() != control::FlatAction::size(n))
+    manisoft::detail::fail("replay: episode ", episode.index, " actions have ", episode.actions.cols(), " columns, the arm needs ", control::FlatAction::size(n));
   if (episode.states.cols() != state_columns(n, static_cast<int>(env.spec().objects.size())))
     manisoft::detail::fail("replay: episode ", episode.index, " states have ", episode.states.cols(), " columns, the scene needs ",
                            state_columns(n, static_cast<int>(env.spec().objects.size())));
@@ -148,9 +147,8 @@ inline long replay_mismatch(task::TaskEnv& env, const Episode& episode) {
     read_state(env, state);
     if (!(state.array() == episode.states.row(r).array()).all()) return r;
     if (env.done()) return r;  // the recording goes on past the replay's end
-    for (int k = 0; k < n; ++k)
-      for (int c = 0; c < 3; ++c) torques(k, c) = episode.actions(r, 3 * k + c);
-    env.step(torques, static_cast<int>(episode.actions(r, 3 * n)));
+    const int s = control::FlatAction::unpack(episode.actions.row(r), torques);
+    env.step(torques, s);
   }
   return env.done() ? -1 : episode.steps();
 }

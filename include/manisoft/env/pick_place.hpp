@@ -50,6 +50,7 @@
 
 #include "manisoft/control/arm_observation.hpp"
 #include "manisoft/control/model_executor.hpp"
+#include "manisoft/control/tool_down.hpp"
 #include "manisoft/core/error.hpp"
 #include "manisoft/rod/cosserat_rod.hpp"
 #include "manisoft/rod/inverse_statics.hpp"
@@ -175,14 +176,7 @@ class PickPlaceRunner {
   rigid::BodyId object() const { return object_; }
 
   /// The tool-down end-effector pose whose grasp centre is at `grasp_center` with yaw `yaw`.
-  Pose tool_down(const Vec3& grasp_center, double yaw) const {
-    Eigen::Matrix3d down;
-    down << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // d1 = +x, d2 = -y, d3 = -z
-    Pose p;
-    p.rotation = Eigen::AngleAxisd(yaw, Vec3::UnitZ()).toRotationMatrix() * down;
-    p.translation = grasp_center - p.rotation * gripper_.grasp_center();
-    return p;
-  }
+  Pose tool_down(const Vec3& grasp_center, double yaw) const { return control::tool_down_pose(grasp_center, yaw, gripper_.grasp_center()); }
 
   /// The task of `seed` (deterministic).
   PickPlaceTask draw_task(std::uint64_t seed) {

@@ -50,6 +50,7 @@
 #include "manisoft/control/action_space.hpp"
 #include "manisoft/control/arm_observation.hpp"
 #include "manisoft/control/executor.hpp"
+#include "manisoft/control/tool_down.hpp"
 #include "manisoft/core/error.hpp"
 #include "manisoft/reward/distance_reward.hpp"
 #include "manisoft/reward/pose_distance.hpp"
@@ -247,10 +248,8 @@ class ReachEnv {
     const double yaw = uniform(rng, -pi, pi);
     const double tilt = std::acos(1 - uniform(rng, 0, 1) * (1 - std::cos(pi / 4)));
     const double tilt_dir = uniform(rng, 0, 2 * pi);
-    Eigen::Matrix3d down;  // d1 = +x, d2 = -y, d3 = -z: the base frame bent down by 90 deg
-    down << 1, 0, 0, 0, -1, 0, 0, 0, -1;
-    const Eigen::Matrix3d r = Eigen::AngleAxisd(tilt, Eigen::Vector3d(std::cos(tilt_dir), std::sin(tilt_dir), 0)).toRotationMatrix() *
-                              Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * down;
+    const Eigen::Matrix3d r =
+        Eigen::AngleAxisd(tilt, Eigen::Vector3d(std::cos(tilt_dir), std::sin(tilt_dir), 0)).toRotationMatrix() * control::tool_down_rotation(yaw);
     return Pose{r, p};
   }
 

@@ -51,6 +51,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "manisoft/assets/asset.hpp"
 #include "manisoft/contact/narrow_phase.hpp"
 #include "manisoft/core/error.hpp"
 #include "manisoft/math/so3.hpp"
@@ -63,12 +64,12 @@ namespace manisoft::interaction {
 struct ParallelGripperParameters {
   double palm_half_x = 0.06;       ///< m, along the closing axis
   double palm_half_y = 0.05;       ///< m
-  double palm_thickness = 0.05;    ///< m, along the approach axis (>= the rod radius: the tip's
-                                   ///< rounded end cap stays inside the palm)
+  double palm_thickness = assets::GraspGripper{}.palm_thickness;  ///< m, along the approach axis (>= the rod radius:
+                                                                 ///< the tip's rounded end cap stays inside the palm)
   double finger_thickness = 0.01;  ///< m, along the closing axis
   double finger_half_width = 0.02; ///< m, along y
-  double finger_length = 0.07;     ///< m, below the palm
-  double open_width = 0.10;        ///< m, between the inner finger faces
+  double finger_length = assets::GraspGripper{}.finger_length;  ///< m, below the palm
+  double open_width = assets::GraspGripper{}.open_width;        ///< m, between the inner finger faces
   double mass = 0.2;               ///< kg (the coupling's design load)
   double friction = 0.8;
   double weld_stiffness = 2e4;            ///< N/m

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "manisoft/control/tool_down.hpp"
 #include "manisoft/core/error.hpp"
 #include "manisoft/interaction/gripper.hpp"
 #include "manisoft/math/se3.hpp"
@@ -28,12 +29,7 @@ namespace manisoft::scene {
 /// The tool-down gripper frame (z = -world z, closing axis x rotated by `yaw` about world z) at
 /// `position` (palm top centre, where the rod tip attaches).
 inline math::Pose<double> tool_down_pose(const Eigen::Vector3d& position, double yaw) {
-  math::Pose<double> p;
-  Eigen::Matrix3d down;
-  down << 1, 0, 0, 0, -1, 0, 0, 0, -1;
-  p.rotation = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * down;
-  p.translation = position;
-  return p;
+  return math::Pose<double>{control::tool_down_rotation(yaw), position};
 }
 
 /// The inverse statics of the scene arm (world::tabletop_arm_parameters at the world's mount,

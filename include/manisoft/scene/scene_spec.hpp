@@ -32,8 +32,11 @@
 
 namespace manisoft::scene {
 
-/// The four tasks (paper section 3.2).
+/// The benchmark's tasks (paper section 3.2; each defined in include/manisoft/task/, listed in
+/// task/registry.hpp).
 enum class Task { coll, aln, stk, arr };
+/// Every task, in the benchmark's order.
+inline constexpr std::array<Task, 4> all_tasks{Task::coll, Task::aln, Task::stk, Task::arr};
 enum class Setting { clean, randomized };
 enum class Split { train, eval };
 
@@ -61,8 +64,15 @@ E parse_name(std::string_view what, std::string_view name, const std::array<E, N
 }
 }  // namespace detail
 
+/// Every task's name, in the benchmark's order ("COLL", "ALN", "STK", "ARR").
+inline std::vector<std::string> task_names() {
+  std::vector<std::string> out;
+  for (const Task t : all_tasks) out.emplace_back(to_string(t));
+  return out;
+}
+
 /// The enumerator that to_string names ("COLL", "clean", "train"); an error lists the names.
-inline Task parse_task(std::string_view name) { return detail::parse_name("task", name, std::array{Task::coll, Task::aln, Task::stk, Task::arr}); }
+inline Task parse_task(std::string_view name) { return detail::parse_name("task", name, all_tasks); }
 inline Setting parse_setting(std::string_view name) { return detail::parse_name("setting", name, std::array{Setting::clean, Setting::randomized}); }
 inline Split parse_split(std::string_view name) { return detail::parse_name("split", name, std::array{Split::train, Split::eval}); }
 
@@ -118,11 +128,15 @@ struct LightingSpec {
   double ambient_intensity = 0.35;
 };
 
-/// How a goal orientation is judged (as task::Symmetry): fully, up to any rotation about the
-/// asset's z axis, or up to a 1/order turn about it.
+/// How a goal orientation is judged: fully, up to any rotation about the asset's z axis (a
+/// bottle, a can), or up to a 1/order turn about it (a box: order 2 or 4).
 struct Symmetry {
   enum class Kind { none, axial, discrete } kind = Kind::none;
-  int order = 1;
+  int order = 1;  ///< discrete: order-fold about z
+
+  static Symmetry none() { return {}; }
+  static Symmetry axial() { return {Kind::axial, 1}; }
+  static Symmetry discrete(int n) { return {Kind::discrete, n}; }
 };
 
 /// ARR: a spatial relation. left_of..next_to: objects = {a}, references = {b} ("a left of b");

@@ -103,6 +103,15 @@ inline void require_consistent(const SceneSpec& s, const AssetLibrary& lib, cons
         for (std::size_t j = 0; j < i; ++j)
           if (s.goal.items[i] == s.goal.items[j]) manisoft::detail::fail(where, ": goal.items repeats object ", s.goal.items[i]);
       }
+      // From the bottom up, each item narrower than the one below (the sampler's order).
+      for (std::size_t i = 1; i < s.goal.items.size(); ++i) {
+        const auto& below = s.objects[static_cast<std::size_t>(s.goal.items[i - 1])].asset_id;
+        const auto& above = s.objects[static_cast<std::size_t>(s.goal.items[i])].asset_id;
+        const double wb = lib.get(below, where).bounding_half_extents.x(), wa = lib.get(above, where).bounding_half_extents.x();
+        if (!(wa < wb))
+          manisoft::detail::fail(where, ": goal.items[", i, "] ('", above, "', half width ", wa, " m) is not narrower than goal.items[", i - 1, "] ('",
+                                 below, "', ", wb, " m): items go from the widest (bottom) to the narrowest (top)");
+      }
       break;
     case Task::arr:
       if (s.goal.relations.empty()) manisoft::detail::fail(where, ": goal.relations is empty");

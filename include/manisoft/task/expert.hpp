@@ -1,5 +1,5 @@
 // The expert of the four ManiSoft tasks (paper section 3.4: a rule-based planner per task whose
-// SE(3) waypoints and gripper states are tracked by the model executor; issue 13, section 3).
+// SE(3) waypoints and gripper states are tracked by the model executor).
 //
 //   task::Expert expert(env);       // env: a task::TaskEnv
 //   env.reset(spec);  expert.reset();

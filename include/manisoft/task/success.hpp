@@ -1,15 +1,16 @@
-// Success predicates of the four ManiSoft tasks (the ManiSoft benchmark paper, "ManiSoft: a
-// vision-language benchmark for soft robotic manipulation", sections 3.2 and 3.4: COLL, ALN, STK,
-// ARR). The paper defines no success criterion; these follow the best rigid-arm benchmarks
-// (RoboTwin 2.0's placement and stacking checks, LIBERO's On/In predicates, ManiSkill's "static"
-// test) with the tolerances in `Tolerances`, all documented in the README ("Tasks").
+// What every task's success predicate reads and shares (the ManiSoft benchmark paper, "ManiSoft:
+// a vision-language benchmark for soft robotic manipulation", sections 3.2 and 3.4): one control
+// step's snapshot of the objects (`Snapshot`: poses, velocities, who touches whom, whether the
+// gripper is open and holds something), the tolerances of every predicate, the failure reasons,
+// "released" and "at rest" (ManiSkill's static test) and `SuccessTracker`, which turns a per-step
+// predicate into an episode's outcome. The predicates themselves are the tasks' own (coll.hpp,
+// aln.hpp, stk.hpp, arr.hpp; the list in registry.hpp); the paper defines no success criterion,
+// so they follow the best rigid-arm benchmarks (RoboTwin 2.0's placement and stacking checks,
+// LIBERO's On/In predicates, ManiSkill's "static" test), documented in docs/tasks.md.
 //
-// Every predicate is a pure function of one control step's snapshot (`Snapshot`: object poses,
-// velocities, who touches whom, whether the gripper is open and holds something), so it can be
-// checked on hand-built states and on recorded episodes alike. Holding a predicate for a while
-// ("at rest for 1 s") is `SuccessTracker`'s job.
-//
-// Spatial words are the viewer's (geometry/spatial_relation.hpp): "left" is world -y, "in front of" +x.
+// Every predicate is a pure function of a snapshot, so it can be checked on hand-built states
+// and on recorded episodes alike. Spatial words are the viewer's (geometry/spatial_relation.hpp):
+// "left" is world -y, "in front of" +x.
 #pragma once
 
 #include <Eigen/Core>
@@ -26,6 +27,7 @@
 #include "manisoft/core/error.hpp"
 #include "manisoft/geometry/spatial_relation.hpp"
 #include "manisoft/math/se3.hpp"
+#include "manisoft/scene/scene_spec.hpp"
 
 namespace manisoft::task {
 
@@ -99,44 +101,27 @@ inline const ObjectState& object_at(const Snapshot& snapshot, int index) {
   return snapshot.objects[static_cast<std::size_t>(index)];
 }
 
-/// Released and at rest: the gripper open, holding nothing of these, all slower than the limits.
-inline bool released_at_rest(const Snapshot& snapshot, std::span<const int> indices, const Tolerances& tol) {
+}  // namespace detail
+
+/// Released: the gripper open and holding none of these objects.
+inline bool released(const Snapshot& snapshot, std::span<const int> indices) {
   if (!snapshot.gripper_open) return false;
+  for (int i : indices)
+    if (detail::object_at(snapshot, i).held) return false;
+  return true;
+}
+
+/// At rest: all of these objects slower than the rest thresholds.
+inline bool all_at_rest(const Snapshot& snapshot, std::span<const int> indices, const Tolerances& tol) {
   for (int i : indices) {
-    if (!at_rest(object_at(snapshot, i), tol)) return false;
+    const ObjectState& o = detail::object_at(snapshot, i);
+    if (!(o.linear_velocity.norm() < tol.rest_linear_speed && o.angular_velocity.norm() < tol.rest_angular_speed)) return false;
   }
   return true;
 }
 
-}  // namespace detail
-
-/// COLL: the object's centre of mass inside the container's inner volume (the receptacle, in
-/// the container's asset frame), the object touching the container and not the table, both
-/// released and at rest.
-inline bool collected(const Snapshot& snapshot, int object, int container, const assets::Receptacle& receptacle,
-                      const Tolerances& tol = {}) {
-  const ObjectState& o = detail::object_at(snapshot, object);
-  const ObjectState& c = detail::object_at(snapshot, container);
-  const std::array<int, 2> both{object, container};
-  if (!detail::released_at_rest(snapshot, both, tol)) return false;
-  if (!o.touches(container) || o.touches_table) return false;
-  // Centre of mass in the opening frame: z up out of the opening, floor at -inner_depth.
-  const Eigen::Vector3d p = receptacle.opening.inverse_act(c.pose.inverse_act(o.center_of_mass));
-  if (p.z() < -receptacle.inner_depth || p.z() > tol.coll_above_rim) return false;
-  if (receptacle.inner_radius > 0) return p.head<2>().norm() <= receptacle.inner_radius;
-  return std::abs(p.x()) <= receptacle.inner_half_extents.x() && std::abs(p.y()) <= receptacle.inner_half_extents.y();
-}
-
-/// How an object's orientation goal is judged: fully, up to a rotation about the asset's z axis
-/// (a bottle, a can), or up to a 1/n turn about it (a box: n = 2 or 4).
-struct Symmetry {
-  enum class Kind { none, axial, discrete } kind = Kind::none;
-  int order = 1;  ///< discrete: n-fold about z
-
-  static Symmetry none() { return {}; }
-  static Symmetry axial() { return {Kind::axial, 1}; }
-  static Symmetry discrete(int n) { return {Kind::discrete, n}; }
-};
+/// How an object's orientation goal is judged (defined with the scene's goal).
+using Symmetry = scene::Symmetry;
 
 /// Angle (rad) between two orientations, modulo the symmetry about the asset's z axis.
 inline double orientation_error(const Eigen::Matrix3d& actual, const Eigen::Matrix3d& goal, const Symmetry& symmetry) {
@@ -161,72 +146,6 @@ inline double orientation_error(const Eigen::Matrix3d& actual, const Eigen::Matr
     }
   }
   return 4.0;
-}
-
-/// ALN: the object's asset origin within `aln_position` of the goal's, its orientation within
-/// `aln_orientation` of the goal's modulo `symmetry`, released and at rest.
-inline bool aligned(const Snapshot& snapshot, int object, const math::Pose<double>& goal, const Symmetry& symmetry,
-                    const Tolerances& tol = {}) {
-  const ObjectState& o = detail::object_at(snapshot, object);
-  const std::array<int, 1> one{object};
-  if (!detail::released_at_rest(snapshot, one, tol)) return false;
-  if ((o.pose.translation - goal.translation).norm() > tol.aln_position) return false;
-  return orientation_error(o.pose.rotation, goal.rotation, symmetry) <= tol.aln_orientation;
-}
-
-/// STK: `items` from the bottom (largest) to the top (smallest): each item touches the one below,
-/// its centre of mass lies higher and within `stk_horizontal` of the one below horizontally, only
-/// the bottom item touches the table, all released and at rest (holding it for a while is
-/// SuccessTracker's job).
-inline bool stacked(const Snapshot& snapshot, std::span<const int> items, const Tolerances& tol = {}) {
-  if (items.size() < 2) ::manisoft::detail::fail("a stack needs at least 2 items, got ", items.size());
-  if (!detail::released_at_rest(snapshot, items, tol)) return false;
-  for (std::size_t k = 1; k < items.size(); ++k) {
-    const ObjectState& below = detail::object_at(snapshot, items[k - 1]);
-    const ObjectState& above = detail::object_at(snapshot, items[k]);
-    if (!above.touches(items[k - 1]) || above.touches_table) return false;
-    if (above.center_of_mass.z() <= below.center_of_mass.z()) return false;
-    if ((above.center_of_mass - below.center_of_mass).head<2>().norm() > tol.stk_horizontal) return false;
-  }
-  return true;
-}
-
-/// ARR: a spatial relation between objects, in the viewer's words (geometry/spatial_relation.hpp).
-struct Relation {
-  using Kind = geometry::RelationKind;
-  Kind kind = Kind::next_to;
-  std::array<int, 4> objects{-1, -1, -1, -1};  ///< left_of..next_to: (a, b) "a <relation> b";
-                                               ///< between: (a, b, c) "a between b and c";
-                                               ///< in_a_row: 3 or 4 objects, -1 ends the list
-  int count() const {
-    int n = 0;
-    while (n < 4 && objects[static_cast<std::size_t>(n)] >= 0) ++n;
-    return n;
-  }
-};
-
-/// Does the relation hold between the objects' centres of mass (horizontal plane)? Positions only.
-inline bool relation_holds(const Snapshot& snapshot, const Relation& relation, const Tolerances& tol = {}) {
-  const int n = relation.count();
-  const int lo = geometry::relation_min_count(relation.kind), hi = geometry::relation_max_count(relation.kind);
-  if (n < lo || n > hi) {
-    ::manisoft::detail::fail("relation ", to_string(relation.kind), " needs ", lo, lo == hi ? "" : " or 4", " objects, got ", n);
-  }
-  std::array<Eigen::Vector2d, 4> centres;
-  for (int k = 0; k < n; ++k)
-    centres[static_cast<std::size_t>(k)] = detail::object_at(snapshot, relation.objects[static_cast<std::size_t>(k)]).center_of_mass.head<2>();
-  return geometry::relation_holds(relation.kind, std::span<const Eigen::Vector2d>(centres.data(), static_cast<std::size_t>(n)), tol.arr);
-}
-
-/// ARR: every relation holds, every object named in them released and at rest.
-inline bool arranged(const Snapshot& snapshot, std::span<const Relation> relations, const Tolerances& tol = {}) {
-  if (relations.empty()) ::manisoft::detail::fail("an arrangement needs at least one relation");
-  for (const Relation& r : relations) {
-    if (!relation_holds(snapshot, r, tol)) return false;
-    const std::span<const int> named(r.objects.data(), static_cast<std::size_t>(r.count()));
-    if (!detail::released_at_rest(snapshot, named, tol)) return false;
-  }
-  return true;
 }
 
 /// Turns a per-step predicate into an episode's outcome: success once the predicate has held for

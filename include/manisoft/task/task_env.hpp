@@ -1,7 +1,7 @@
-// The task environment of the four ManiSoft tasks (paper sections 3.2 and 3.4; issue 13): one
-// scene (scene::SceneSpec) in the one arm world (world::ArmWorld on the tabletop), stepped one
-// control step at a time through the actuation limits, with the task's success predicate
-// (task/success.hpp) judged after every step.
+// The task environment of the ManiSoft tasks (paper sections 3.2 and 3.4): one scene
+// (scene::SceneSpec) in the one arm world (world::ArmWorld on the tabletop), stepped one control
+// step at a time through the actuation limits, with the task's success predicate (its named
+// conditions, task/registry.hpp) judged after every step.
 //
 //   task::TaskEnv env(library);          // builds the arm and brings it home once
 //   env.reset(spec);                     // the scene's bodies, the arm at home, step 0
@@ -15,12 +15,16 @@
 // Success: the predicate holds (released and at rest included) for `hold_steps` consecutive
 // control steps; the episode ends at the first such step (success once) and `success_at_end()`
 // says whether it still held at the last step (ManiSkill reports both).
-// Failure reasons (FailureReason): scene_invalid (an ALN or ARR goal holds already at reset: no
-// task; the episode ends before its first step), diverged (the step was refused: the world is as before it, the
+// Failure reasons (FailureReason): scene_invalid (the goal holds already at reset, as far as
+// positions tell: no task; the episode ends before its first step), diverged (the step was refused: the world is as before it, the
 // episode ends), object_off_table (a scene object left the table top: ends the episode),
 // arm_hit_obstacle (the rod or the gripper touched an obstacle at some step; the episode goes on,
 // the reason is reported if it does not succeed), object_dropped (a held object slipped or was
-// released away from the goal and the episode timed out), timeout.
+// released away from the goal and the episode timed out), timeout. The first three end the
+// episode (StepInfo::terminated), the others are reported when the horizon ends it
+// (StepInfo::truncated), as Gymnasium's terminated / truncated.
+// conditions() names which parts of the predicate held at the last step: a failed episode's
+// explanation.
 // No heap allocation in step() once reset() has sized everything.
 #pragma once
 
@@ -29,18 +33,20 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <variant>
 #include <string>
 #include <vector>
 
 #include "manisoft/control/arm_observation.hpp"
 #include "manisoft/control/model_executor.hpp"
+#include "manisoft/control/tool_down.hpp"
 #include "manisoft/core/error.hpp"
 #include "manisoft/rod/cosserat_rod.hpp"
 #include "manisoft/rod/inverse_statics.hpp"
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/scene/scene_spec.hpp"
 #include "manisoft/scene/scene_world.hpp"
-#include "manisoft/task/success.hpp"
+#include "manisoft/task/registry.hpp"
 #include "manisoft/world/arm_world.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
 
@@ -83,7 +89,14 @@ struct StepInfo {
   bool done = false;     ///< success, horizon or a terminal failure
   FailureReason failure = FailureReason::none;  ///< set once done without success
   int clamped = 0;       ///< torque entries clamped to the actuation limits this step
+  bool terminated = false;  ///< done by success or a terminal failure (diverged, object_off_table, scene_invalid)
+  bool truncated = false;   ///< done by the horizon without success
 };
+
+/// Whether a failure ends the episode where it happens (the others are reported at the horizon).
+inline bool is_terminal(FailureReason reason) {
+  return reason == FailureReason::diverged || reason == FailureReason::object_off_table || reason == FailureReason::scene_invalid;
+}
 
 class TaskEnv {
  public:
@@ -132,18 +145,17 @@ class TaskEnv {
     for (std::size_t i = 0; i < bodies_.objects.size(); ++i) object_of_body_[bodies_.objects[i]] = static_cast<int>(i);
     for (const auto b : bodies_.obstacles) obstacle_body_[b] = 1;
     states_.assign(spec_.objects.size(), ObjectState{});
-    receptacle_ = spec_.task == scene::Task::coll ? container_receptacle() : assets::Receptacle{};
-    relations_.clear();
-    for (const auto& r : spec_.goal.relations) relations_.push_back(to_task_relation(r));
+    goal_ = visit_task(spec_.task, [this]<TaskType T>(T) { return GoalVariant(T::goal(spec_, *library_)); });
     tracker_ = SuccessTracker(config_.hold_steps);
     info_ = StepInfo{};
     touched_obstacle_ = false;
     dropped_ = false;
     last_event_step_ = 0;
     update_states();
+    predicate();
     // A goal that holds before any action is no task: the scene is invalid (the episode ends).
-    // Contacts are known only after a step, so this catches the position-only goals (ALN, ARR).
-    if (predicate()) finish(FailureReason::scene_invalid);
+    const bool met = std::visit([this](const auto& g) { return task_of<decltype(g)>::holds_at_start(snapshot(), g, config_.tolerances); }, goal_);
+    if (met) finish(FailureReason::scene_invalid);
   }
 
   /// One control step: element torques (n x 3, material frame; clamped to the actuation limits)
@@ -167,6 +179,7 @@ class TaskEnv {
     if (tracker_.update(info_.step, predicate())) {
       info_.success = true;
       info_.done = true;
+      info_.terminated = true;
       return info_;
     }
     for (const auto b : bodies_.objects)
@@ -179,6 +192,8 @@ class TaskEnv {
 
   // ---- state
   const StepInfo& info() const { return info_; }
+  /// The predicate's named conditions at the last step (or at reset): which held, which did not.
+  const Conditions& conditions() const { return conditions_; }
   bool done() const { return info_.done; }
   /// Whether the predicate held at the last step (ManiSkill's "success at end").
   bool success_at_end() const { return tracker_.holds_now(); }
@@ -200,14 +215,7 @@ class TaskEnv {
   const Executor& home_executor() const { return home_executor_; }
   /// The home pose (end-effector frame) and the tool-down pose with grasp centre `c`, yaw `yaw`.
   Pose home_pose() const { return tool_down(config_.home, 0.0); }
-  Pose tool_down(const Vec3& grasp_center, double yaw) const {
-    Eigen::Matrix3d down;
-    down << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // d1 = +x, d2 = -y, d3 = -z
-    Pose p;
-    p.rotation = Eigen::AngleAxisd(yaw, Vec3::UnitZ()).toRotationMatrix() * down;
-    p.translation = grasp_center - p.rotation * gripper_.grasp_center();
-    return p;
-  }
+  Pose tool_down(const Vec3& grasp_center, double yaw) const { return control::tool_down_pose(grasp_center, yaw, gripper_.grasp_center()); }
   const interaction::ParallelGripperParameters& gripper_parameters() const { return gripper_; }
   const rod::ArmModel<double>& arm_model() const { return model_; }
   double control_dt() const { return config_.dt * config_.substeps; }
@@ -256,35 +264,15 @@ class TaskEnv {
     world_.reset();
   }
 
-  assets::Receptacle container_receptacle() const {
-    const auto& c = spec_.objects.at(static_cast<std::size_t>(spec_.goal.container));
-    const auto& a = library_->get(c.asset_id, "COLL container");
-    if (a.receptacles.empty()) manisoft::detail::fail("TaskEnv::reset: the COLL container ", c.asset_id, " has no receptacle annotation");
-    return a.receptacles.front();
-  }
-  static Relation to_task_relation(const scene::Relation& r) {
-    Relation t;
-    t.kind = r.kind;
-    std::size_t k = 0;
-    for (int i : r.objects) t.objects.at(k++) = i;
-    for (int i : r.references) t.objects.at(k++) = i;
-    return t;
-  }
+  using GoalVariant = std::variant<Coll::Goal, Aln::Goal, Stk::Goal, Arr::Goal>;
+  /// The task type whose Goal `G` is.
+  template <typename G>
+  using task_of = typename std::decay_t<G>::Task;
 
-  bool predicate() const {
-    const Snapshot s = snapshot();
-    const auto& g = spec_.goal;
-    const auto& tol = config_.tolerances;
-    switch (spec_.task) {
-      case scene::Task::coll: return collected(s, g.object, g.container, receptacle_, tol);
-      case scene::Task::aln: {
-        const Symmetry sym{static_cast<Symmetry::Kind>(static_cast<int>(g.symmetry.kind)), g.symmetry.order};
-        return aligned(s, g.object, g.goal_pose, sym, tol);
-      }
-      case scene::Task::stk: return stacked(s, g.items, tol);
-      case scene::Task::arr: return arranged(s, relations_, tol);
-    }
-    return false;
+  /// Evaluates the task's conditions at the current step; true when all hold.
+  bool predicate() {
+    conditions_ = std::visit([this](const auto& g) { return task_of<decltype(g)>::evaluate(snapshot(), g, config_.tolerances); }, goal_);
+    return conditions_.all();
   }
 
   void update_states() {
@@ -330,6 +318,8 @@ class TaskEnv {
   const StepInfo& finish(FailureReason reason) {
     info_.done = true;
     info_.failure = reason;
+    info_.terminated = is_terminal(reason);
+    info_.truncated = !info_.terminated;
     return info_;
   }
 
@@ -349,8 +339,8 @@ class TaskEnv {
   std::vector<int> object_of_body_;
   std::vector<char> obstacle_body_;
   std::vector<ObjectState> states_;
-  assets::Receptacle receptacle_;
-  std::vector<Relation> relations_;
+  GoalVariant goal_;
+  Conditions conditions_;
   SuccessTracker tracker_{1};
   StepInfo info_;
   bool touched_obstacle_ = false, dropped_ = false;
