@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Starts a single-node Slurm cluster on this machine (Debian slurm-wlm + munge), enough to run the
-# README's sbatch --array recipe for generate_dataset for real. Needs root. Writes its config to
+# sbatch --array recipe of docs/dataset.md for generate_dataset for real. Needs root. Writes its config to
 # /etc/slurm/slurm.conf (this host as the controller and the only compute node, all its cores),
 # starts munged, slurmctld and slurmd in the background, and waits until the node is idle.
 #   scripts/slurm_single_node.sh          start;   scripts/slurm_single_node.sh stop

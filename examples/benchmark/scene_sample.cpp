@@ -1,5 +1,5 @@
 // scene_sample: draws one ManiSoft scene (include/manisoft/scene/scene_sampler.hpp) and writes
-// its JSON (README "Scenes" has the schema):
+// its JSON (docs/scenes.md has the schema):
 //   scene_sample --task COLL|ALN|STK|ARR --setting clean|randomized --index I --seed S
 //                [--split train|eval] --out scene.json
 // Prints the objects, obstacles, instruction and goal (scene::list_items) and the redraw count. Exit 2 on bad

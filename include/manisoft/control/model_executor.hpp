@@ -12,7 +12,7 @@
 // inwards, what the clamp cuts off an element is added to the next proximal element
 // (carry_saturation): the couple carried across every other node is then still the one asked for
 // (sum_{j >= k} tau_j), only the node between the two elements sees the difference (without it,
-// targets near the limits slip into a slow saturated oscillation; BENCHMARKS.md, "Executor").
+// targets near the limits slip into a slow saturated oscillation).
 //   tau_ff    the inverse statics feed-forward of the current shape target (inverse_statics.hpp),
 //             with the elastic part scaled by the stiffness estimate s_hat;
 //   tau_fb    node forces F_j = -m_j (kd v_j + kp (x_j - x*_j)) (positions and velocities of
@@ -26,7 +26,7 @@
 //             tangent onto the observed one. The position term matters beyond steady-state
 //             accuracy: the feed-forward torques are follower (material-frame) loads, and on
 //             strongly curled shapes the equilibrium they hold flutters unless the feedback is
-//             stiff enough (the gains' choice: BENCHMARKS.md, "Executor").
+//             stiff enough.
 //   twist     the position feedback cannot see twist: a twist couple -k_tw phi (s_k / L) on every
 //             element, phi the twist of the observed end-effector frame about the tip tangent
 //             relative to the estimated tip frame, holds the twist of curled shapes (without it
@@ -128,7 +128,7 @@ struct ModelExecutorSettings {
   Scalar max_stiffness_scale = Scalar(2);
   Scalar twist_gain = Scalar(20);          ///< N m/rad: twist couple -k phi_tip (s_k / L) on the tip twist error
   Scalar twist_damping = Scalar(0);        ///< N m s/rad: twist couple -c w_tip (s_k / L) from end-effector
-                                           ///< pose differences (0: off; BENCHMARKS.md has the runs)
+                                           ///< pose differences (0: off)
   // ---- trajectory tracking (track_line)
   Scalar knot_spacing = Scalar(0.01);      ///< m of tip travel between knots of a path, at most
   Scalar knot_angle = Scalar(0.05);        ///< rad of tip rotation between knots, at most
@@ -143,11 +143,11 @@ struct ModelExecutorSettings {
   Scalar converged_rotation = Scalar(0.05);   ///< rad
   Scalar converged_speed = Scalar(0.05);      ///< m/s, every observed node
 
-  /// The defaults with a smooth shape ramp (issue 10's transient limits: no node faster than
-  /// 1.5 m/s, no tip path longer than 1.5 x the straight distance): the planned peak node speed
+  /// The defaults with a smooth shape ramp (transient limits: no node faster than 1.5 m/s, no
+  /// tip path longer than 1.5 x the straight distance): the planned peak node speed
   /// bounded by `max_node_step` (m per control step), via shapes where a blend's tip path exceeds
   /// 1.2 x its straight distance, the cruise timing (peak 1.33 x the mean speed), and ramps up to
-  /// `max_ramp` control steps long. Slower than the default ramp (BENCHMARKS.md, "Executor").
+  /// `max_ramp` control steps long. Slower than the default ramp (docs/executors.md).
   static ModelExecutorSettings smooth_ramp(Scalar max_node_step, int max_ramp) {
     ModelExecutorSettings s;
     s.ramp_max_node_step = max_node_step;
@@ -407,7 +407,7 @@ class ModelExecutor {
   /// estimate assumes the arm carries nothing but its model and payload: a planner that knows its
   /// tool presses on something (fingers around an object, a held object set on its support)
   /// freezes it meanwhile, or that contact's deflection is read as a stiffness error and the
-  /// feed-forward changes under the contact (a twist chatter of 10-15 rad/s at the tip was seen).
+  /// feed-forward changes under the contact (it can drive a twist chatter at the tip).
   /// A partial averaging period is dropped either way.
   void freeze_estimate(bool frozen) {
     if (frozen != estimate_frozen_) adapt_count_ = 0;

@@ -1,4 +1,4 @@
-// Recording a task episode into a dataset::Episode and replaying it (issue 15; the paper's
+// Recording a task episode into a dataset::Episode and replaying it (the paper's
 // scene-trajectory pairs, section 3.5). Per control step, before its action:
 //   actions           the element torques (n x 3, row by row) then S: what TaskEnv::step received
 //   states            rod node positions ((n+1) x 3), every object's pose (position, quaternion

@@ -1,5 +1,5 @@
-// Pick and place in the tabletop world with the model executor as a trajectory tracker (issue 10;
-// the expert of the paper's tasks, section 3.4-3.5): the reusable routine behind
+// Pick and place in the tabletop world with the model executor as a trajectory tracker (the
+// expert of the paper's tasks, section 3.4-3.5): the reusable routine behind
 // examples/benchmark/pick_place_eval.cpp.
 //
 //   env::PickPlaceRunner runner(config);          // builds the world, brings the arm home (once)

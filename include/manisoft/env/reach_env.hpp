@@ -34,7 +34,7 @@
 //               with heavy uniform damping; actuations that do not settle within 4 s
 //               (follower-torque flutter) or whose pose the inverse statics cannot hold within
 //               the limits are redrawn.
-// BENCHMARKS.md ("Executor") has the measured acceptance rates of both sets.
+// docs/executors.md describes both sets; BENCHMARKS.md has the executor's results on them.
 #pragma once
 
 #include <Eigen/Core>

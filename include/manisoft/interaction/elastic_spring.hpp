@@ -15,8 +15,7 @@
 // rotational one (kM against the tip element's bending inertia, 2.5e-4 kg m^2) omega dt = 0.13.
 // `arm()`, the arm world's default, is stiff() with kM = 1000 N m/rad (omega dt = 0.4) and
 // cM = 0.6 N m s/rad: the executor drives the tip element with up to 150 N m, and a gripper
-// carrying a load must follow the tip's rotation closely (BENCHMARKS.md, "Executor", has the
-// runs behind the choice).
+// carrying a load must follow the tip's rotation closely.
 #pragma once
 
 #include <Eigen/Core>

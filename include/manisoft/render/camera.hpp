@@ -20,7 +20,7 @@
 namespace manisoft::render {
 
 /// A pinhole camera as a user places it. Defaults: the paper's 514 x 514, 60 degree camera
-/// mapped into the ManiSoft world frame (README.md, "Rendering").
+/// mapped into the ManiSoft world frame (docs/rendering.md).
 struct Camera {
   Eigen::Vector3d position{2.0, 0.0, 2.35};  ///< m, world frame
   Eigen::Vector3d look_at{0.4, 0.0, 0.95};   ///< m, world point at the image centre

@@ -7,7 +7,7 @@
 // into framebuffer objects of an EGL context without a display (egl_context.hpp). Same inputs give
 // the same pixels.
 //
-// Speed on a CPU (Mesa llvmpipe, BENCHMARKS.md "Renderer"): llvmpipe runs every instruction of a
+// Speed on a CPU (Mesa llvmpipe; measurements in BENCHMARKS.md): llvmpipe runs every instruction of a
 // fragment shader on every pixel (both sides of a branch, under a mask), so the shaders are
 // specialised at compile time (texture kind, light kind, shadows) and kept short; a directional
 // light's shadow map is rendered only over the shadow casters' extent (a sub-rectangle of the map

@@ -70,7 +70,7 @@ inline std::map<std::uint16_t, ObjectBounds> object_bounds(const SceneDescriptio
   return out;
 }
 
-/// The parallel gripper's parts (same geometry as world/gripper.hpp's ParallelGripper defaults):
+/// The parallel gripper's parts (same geometry as interaction/gripper.hpp's ParallelGripper defaults):
 /// frame origin at the centre of the palm's top face, +z the approach axis (into the palm and on
 /// along the fingers), +x the closing axis.
 struct GripperGeometry {

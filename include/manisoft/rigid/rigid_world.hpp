@@ -727,8 +727,7 @@ class RigidWorld {
       // body moves: a rolling body's contact is not a material point (the cached extrapolation
       // would let it sink and would move the lever arm). A cylinder rocking on its cap keeps four
       // of its rim points; cached, the rim between them sank as the tilt turned and was pushed
-      // back out at the next detection, a lift that fed the rocking (a candle stick tilted
-      // 0.01 rad and spun at 1 rad/s rocked up to 0.11 rad in 3 s). Face contacts of polyhedra
+      // back out at the next detection, a lift that fed the rocking. Face contacts of polyhedra
       // (SAT) use the cache; bodies at rest sleep.
       const auto ka = geoms_[m.geom_a].shape.kind, kb = geoms_[m.geom_b].shape.kind;
       const bool analytic_round = (is_round(ka) && (is_round(kb) || kb == contact::ShapeKind::box)) ||

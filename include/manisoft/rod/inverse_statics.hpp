@@ -31,8 +31,7 @@
 // solve() starts from the previous solution. Cold targets (solve_cold) start from the entries of
 // a start library whose tip poses are nearest the target (1500 deterministic random curvature
 // profiles within the actuation limits, built at construction), then the previous solution and
-// the straight shape, on a budget of LM iterations over all starts (costs: BENCHMARKS.md,
-// "Executor").
+// the straight shape, on a budget of LM iterations over all starts.
 // Model estimates (set_model_estimates): the feed-forward can assume a stiffness scale and a
 // payload other than the model's without re-solving the shape (used by the model executor).
 // No heap allocation after construction.

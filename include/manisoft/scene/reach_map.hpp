@@ -1,5 +1,4 @@
-// The arm's reachable table area (issue 12, "the arm reaches the whole table the scenes use";
-// paper figure 4c: targets "broadly and evenly distributed across the entire table"): for a grid
+// The arm's reachable table area (the scenes use only what the arm reaches; paper figure 4c: targets "broadly and evenly distributed across the entire table"): for a grid
 // of cells over the table top, whether a tool-down gripper pose above the cell centre, at a given
 // height above the top, has a static equilibrium within the actuation limits (rod::InverseStatics
 // + rod::ActuationLimits) whose rod stays clear of the table. Samplers place objects only in
@@ -52,7 +51,7 @@ inline bool pose_reachable(rod::InverseStatics<double>& statics, const math::Pos
   return true;
 }
 
-/// Where samplers place things: the measured reachable area (measure_reach_map; README "Scenes"
+/// Where samplers place things: the measured reachable area (measure_reach_map; docs/scenes.md
 /// has the picture) as two simple shapes, both shrunk by `margin`:
 ///  - the band in front of the base in which tool-down poses at height h (gripper frame above the
 ///    table top) are reachable, an annulus of radii r_in(h) = inner + inner_slope h and
@@ -60,8 +59,7 @@ inline bool pose_reachable(rod::InverseStatics<double>& statics, const math::Pos
 ///  - the two back corners of the table beside the base (x <= corner_x_max, |y| >= corner_y_min),
 ///    reached with the gripper turned a quarter turn: only with `corners` (off by default). The
 ///    arm reaches them curled back beside its base, and moves between them and the annulus are
-///    where the expert fails most (refused or slow lines, lost objects): BENCHMARKS.md, "Expert
-///    episodes".
+///    where the expert fails most (refused or slow lines, lost objects).
 /// The coefficients are design parameters read off the measured maps; every sampled pose is still
 /// checked with the inverse statics before a scene is returned.
 struct ReachBand {

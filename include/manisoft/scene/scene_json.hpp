@@ -1,5 +1,5 @@
-// The scene JSON format (issue 12: a SceneSpec "round-trips exactly through JSON; a malformed or
-// inconsistent file gets a clear error"), through nlohmann-json (optional component
+// The scene JSON format (a SceneSpec round-trips exactly through JSON; a malformed or
+// inconsistent file gets a clear error), through nlohmann-json (optional component
 // manisoft::scene). Doubles are written in nlohmann's shortest round-trip form, so a written file
 // parses back bit-identical; rotations are stored as 3 x 3 matrices (rows) for that reason.
 // Reading refuses, naming the file and the field ("scene.json: objects[2].pose.position[1]"): a
@@ -7,7 +7,7 @@
 // number, an unknown enum name, and (load_scene) an inconsistent scene (require_consistent: unknown
 // asset id, index out of range, a rotation that is not one, another arm mount). Writing goes
 // through a temporary file renamed into place: never a half-written file. The schema, with an
-// example, is in the README ("Scenes").
+// example, is in docs/scenes.md.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -1,4 +1,4 @@
-// Portable random draws for scene sampling (issue 12: the same (task, setting, index, seed) gives
+// Portable random draws for scene sampling (the same (task, setting, index, seed) gives
 // the identical scene from the g++ and the clang build): std::mt19937_64's raw output (specified
 // by the standard) turned into numbers by our own code (the standard distributions are not
 // portable), and the seed derivation that keeps training and evaluation scenes apart.

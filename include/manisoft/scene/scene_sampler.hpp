@@ -1,5 +1,5 @@
 // Scene samplers of the four tasks in the clean and randomized settings (paper sections 3.2,
-// 3.3 and 3.5, figure 4c; issue 12):
+// 3.3 and 3.5, figure 4c):
 //  COLL  a designated object of one of the paper's 13 categories + a container (a basket);
 //  ALN   a bottle, shoe or candle stick + a goal pose (upright, a yaw) on the table;
 //  STK   2-4 bowls or plates of graded size (strictly decreasing width) within stk_spread of the

@@ -1,5 +1,5 @@
-// Scene checks (issue 12, "every sampled scene is valid, checked before it is returned"; the
-// stability test is RoboTwin 2.0's): a SceneSpec is
+// Scene checks (every sampled scene is valid, checked before it is returned; the stability test
+// is RoboTwin 2.0's): a SceneSpec is
 //  - consistent: known asset ids of the right kind, finite poses on the table, goal indices in
 //    range and of the right kind (a COLL container has a receptacle), the world's arm mount;
 //  - free of interpenetration: after one rigid step no contact point (object, obstacle, table) is

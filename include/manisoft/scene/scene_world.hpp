@@ -1,5 +1,4 @@
-// Builds the physical scene of a SceneSpec (issue 12, "a function builds the world from a
-// SceneSpec"; paper section 3.3): rigid body descriptions of its assets (collision shape, mass,
+// Builds the physical scene of a SceneSpec (paper section 3.3): rigid body descriptions of its assets (collision shape, mass,
 // inertia about the centre of mass, friction from the asset), added to an ArmWorld (table and
 // floor, static obstacles, dynamic objects, in the spec's order) or to a bare RigidWorld (what the
 // scene validation settles). The arm's mount is the world's (world/tabletop_scene.hpp): a spec

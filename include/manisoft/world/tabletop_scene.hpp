@@ -6,13 +6,11 @@
 // z = 0.75 m; the arm's base is behind the back edge (x = 0), centred (y = 0).
 // Mount: base at (-0.05, 0, 0.75 + 0.75) = 75 cm above the top, 5 cm behind its back edge,
 // pointing forward horizontally (d3 = +x, d1 = +z, d2 = -y), as the reach task assumes (base
-// 0.75 m above the table plane). It was chosen with the reachable-workspace map of
-// examples/world_demo.cpp (`world_demo --map`): of 9 candidate mounts (0.45 / 0.6 / 0.75 m above
-// the top x pitch 0 / 30 / 60 degrees down) it lands grasp-capable equilibria (arm clear of the
-// top, grasp centre 2-20 cm above it, tool axis within 45 degrees of straight down) in the most
-// 10 cm cells of the table top: 18 of 80, against 5 for the next best (0.75 m, 30 degrees) and
-// 0-3 for the lower mounts, whose sagging arm hits the top before the gripper turns down
-// (README.md, "world_demo", has the table and the map).
+// 0.75 m above the table plane). Of the mounts 0.45 / 0.6 / 0.75 m above the top, pitched 0 / 30 /
+// 60 degrees down, it is the one whose grasp-capable equilibria (arm clear of the top, grasp centre
+// 2-20 cm above it, tool axis within 45 degrees of straight down) cover the most of the table top:
+// lower mounts sag onto the top before the gripper turns down. `world_demo --map` measures it
+// (docs/physics.md, "world_demo").
 #pragma once
 
 #include <cmath>
