@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/language_matcher.hpp"
 #include "../support/scratch_dir.hpp"
 #include "manisoft/assets/catalog.hpp"
 #include "manisoft/language/instructions.hpp"
@@ -50,30 +51,9 @@ assets::Asset make(const std::string& category, const std::string& color, const 
   return a;
 }
 
-/// Independent matcher: every truthful phrasing of an object ("the [size] [colour] [material]
-/// <noun or its head words> [with the <colour> <part>]"), as strings.
+/// The independent matcher (tests/support/language_matcher.hpp) with the shipped library.
 std::set<std::string> truthful_phrasings(const assets::Asset& a, const std::string& scene_color = "") {
-  const std::string color = scene_color.empty() ? a.attributes.color_name : scene_color;
-  std::set<std::string> nouns;
-  const lang::Split split = library().nouns_of(a.category);
-  for (const auto* list : {&split.seen, &split.unseen})
-    for (const std::string& n : *list)
-      for (std::size_t at = 0; at != std::string::npos; at = n.find(' ', at + 1)) nouns.insert(at == 0 ? n : n.substr(at + 1));
-  std::vector<std::string> clauses{""};
-  for (std::size_t k = 0; k < a.visual.size(); ++k)
-    clauses.push_back(" with the " + (k == 0 ? color : a.visual[k].color_name) + " " + a.visual[k].name);
-  std::set<std::string> out;
-  const std::string size = assets::to_string(a.attributes.size);
-  for (const auto& noun : nouns)
-    for (int mask = 0; mask < 8; ++mask)
-      for (const auto& clause : clauses) {
-        std::string s = "the ";
-        if (mask & 1) s += size + " ";
-        if (mask & 2) s += color + " ";
-        if (mask & 4) s += a.attributes.material_name + " ";
-        out.insert(s + noun + clause);
-      }
-  return out;
+  return manisoft::test::truthful_phrasings(library(), a, scene_color);
 }
 
 lang::SceneObject on(const assets::Asset& asset, const std::string& color = "") {
@@ -84,9 +64,7 @@ lang::SceneObject on(const assets::Asset& asset, const std::string& color = "") 
 }
 
 int count_matches(const std::string& expression, const std::vector<lang::SceneObject>& scene) {
-  int n = 0;
-  for (const auto& o : scene) n += truthful_phrasings(*o.asset, o.color_name).count(expression) ? 1 : 0;
-  return n;
+  return manisoft::test::count_matches(library(), expression, scene);
 }
 
 std::vector<std::string> texts(const std::vector<lang::Description>& ds) {
@@ -307,4 +285,47 @@ TEST_CASE("malformed language files are refused naming the file and the entry", 
   CHECK_THROWS_WITH(load_with(tasks_with(coll, aln), R"({"nouns": {}})"), Contains("objects.json: entry 'categories' must be"));
   std::filesystem::remove(dir / "tasks.json");
   CHECK_THROWS_WITH(lang::Library::load(dir), Contains("tasks.json: cannot open the language file"));
+}
+
+TEST_CASE("the word helpers: whole words, case-insensitive, placeholders stand for words", "[language]") {
+  using manisoft::test::says;
+  CHECK(says("drink carton", "carton"));
+  CHECK(says("Picture Frame", "frame"));
+  CHECK(says("Put the award cup into the basket.", "award"));
+  CHECK_FALSE(says("candle holder", "can"));  // a word, not a prefix of one
+  CHECK_FALSE(says("soda can", "drink can"));
+  CHECK(says("midway between {B} and {C}", "between {B} and {C}"));
+  CHECK_FALSE(says("midway between {B} and {C}", "halfway between {B} and {C}"));
+  CHECK(says("Put the cup halfway between the red bottle and the mug.", "halfway between {B} and {C}"));
+  CHECK_FALSE(says("Put the cup midway between the red bottle and the mug.", "halfway between {B} and {C}"));
+  CHECK(says("Let the cup rest close to the shoe.", "close to {B}"));
+  CHECK_FALSE(says("Put the cup in front of the shoe, closer to the camera.", "close to {B}"));
+}
+
+TEST_CASE("unseen wording is never a word of seen wording: every category's nouns, every relation's phrases", "[language]") {
+  // An unseen noun or relation phrase inside a seen noun, phrase or template would reach training
+  // instructions: the unseen-instruction results would not measure wording never trained on.
+  const lang::Library& l = library();
+  CHECK(manisoft::test::wording_leaks(l) == std::vector<std::string>{});
+  const std::set<std::string> own_words = manisoft::test::unseen_only_words(l);
+  for (const auto& [kind, split] : l.relations) {
+    // each unseen relation phrase has a word that no seen wording has ("beyond", "halfway"), so a
+    // seen instruction can be checked for it word by word
+    for (const auto& u : split.unseen) {
+      bool own_word = false;
+      for (const auto& w : manisoft::test::words_of(u)) own_word = own_word || own_words.count(w) > 0;
+      CAPTURE(kind, u);
+      CHECK(own_word);
+    }
+  }
+  // The check finds a leak: a box drink whose unseen noun "carton" is a word of its seen "drink
+  // carton", and a jar whose unseen "pot" is a word of another category's seen "flower pot".
+  lang::Library leaky = l;
+  leaky.nouns["box_drink"] = lang::Split{{"box drink", "drink carton"}, {"carton"}};
+  leaky.nouns["jar"] = lang::Split{{"jar"}, {"pot"}};
+  const std::vector<std::string> leaks = manisoft::test::wording_leaks(leaky);
+  CAPTURE(leaks);
+  CHECK(std::find(leaks.begin(), leaks.end(), "box_drink: unseen 'carton' is in seen 'drink carton'") != leaks.end());
+  CHECK(std::find(leaks.begin(), leaks.end(), "jar: unseen 'pot' is in seen 'flower pot'") != leaks.end());
+  CHECK(leaks.size() == 4);  // and "pot" in "plant pot" and "watering pot"
 }
