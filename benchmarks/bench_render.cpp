@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "manisoft/render/gl_renderer.hpp"
-#include "tabletop_render_scene.hpp"
+#include "manisoft/render/tabletop_render_scene.hpp"
 
 using namespace manisoft::render;
 

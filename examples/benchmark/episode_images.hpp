@@ -1,9 +1,9 @@
 // Camera images of a recorded episode, rendered while its actions replay in a TaskEnv (the replay
 // is exact, so the images are those of the original run): generate_dataset (--images every:K)
-// and render_dataset ("physics first, images later") share it. OpenGL through EGL
-// (render::GlRenderer, colour only) or Blender (one headless process per episode, rendering all
-// of its frames: examples/render/blender_run.hpp), the scene drawn as
-// examples/render/spec_render_scene.hpp does.
+// and render_dataset ("physics first, images later") share it. Any render::Renderer backend
+// reading colour only (EpisodeImages: render::GlRenderer, OpenGL through EGL) or Blender (one
+// headless process per episode, rendering all of its frames: examples/render/blender_run.hpp),
+// the scene drawn as scene::make_render_scene (manisoft/scene/scene_render.hpp) makes it.
 #pragma once
 
 #include <cstdio>
@@ -14,21 +14,23 @@
 #include <vector>
 
 #include "../render/blender_run.hpp"
-#include "../render/spec_render_scene.hpp"
 #include "manisoft/control/action_layout.hpp"
 #include "manisoft/dataset/episode.hpp"
 #include "manisoft/render/gl_renderer.hpp"
+#include "manisoft/render/renderer.hpp"
+#include "manisoft/scene/scene_render.hpp"
 #include "manisoft/task/task_env.hpp"
 
 namespace manisoft_examples {
 
-class EpisodeImages {
+template <manisoft::render::Renderer R>
+class BasicEpisodeImages {
  public:
   /// `camera`: the view (its width and height are the images'); unset: each scene's own camera
-  /// at width x height. `blender`: render with Blender instead of OpenGL, in `blender_dir`
+  /// at width x height. `blender`: render with Blender instead of R, in `blender_dir`
   /// (scratch: the exported scene and the PNG frames of the episode being rendered).
-  EpisodeImages(int width, int height, std::optional<manisoft::render::Camera> camera = std::nullopt,
-                std::optional<manisoft::render::blender::RunOptions> blender = std::nullopt, std::filesystem::path blender_dir = {})
+  BasicEpisodeImages(int width, int height, std::optional<manisoft::render::Camera> camera = std::nullopt,
+                     std::optional<manisoft::render::blender::RunOptions> blender = std::nullopt, std::filesystem::path blender_dir = {})
       : width_(width), height_(height), camera_(camera), blender_(blender), blender_dir_(std::move(blender_dir)) {}
 
   /// Replays `e` (actions) from `spec` in `env`, an image every `every` control steps from step 0.
@@ -53,18 +55,13 @@ class EpisodeImages {
 
  private:
   void set_scene(const manisoft::scene::SceneSpec& spec, const manisoft::scene::AssetLibrary& library) {
-    if (!gl_ && !blender_) {
-      manisoft::render::GlRendererOptions o;
-      o.read_depth = false;
-      o.read_mask = false;
-      gl_ = std::make_unique<manisoft::render::GlRenderer>(o);
-    }
-    scene_ = manisoft::render::spec::make_spec_scene(spec, library);
+    if (!renderer_ && !blender_) renderer_ = manisoft::render::make_colour_renderer<R>();
+    scene_ = manisoft::scene::make_render_scene(spec, library);
     manisoft::render::Camera camera = camera_ ? *camera_ : spec.cameras.front();
     camera.width = width_;
     camera.height = height_;
     scene_.scene.cameras = {camera};
-    if (gl_) gl_->set_scene(scene_.scene);
+    if (renderer_) renderer_->set_scene(scene_.scene);
   }
 
   void add_image(const manisoft::task::TaskEnv& env, manisoft::dataset::ImageSequence& images, long step) {
@@ -73,14 +70,14 @@ class EpisodeImages {
     objects_.clear();
     for (const auto b : env.bodies().objects) objects_.push_back({w.rigid().orientation(b).toRotationMatrix(), w.rigid().position(b)});
     const manisoft::render::FrameState frame =
-        manisoft::render::spec::task_frame(scene_, w.rod().state().positions, gripper, w.gripper().finger_width(), objects_);
+        manisoft::scene::render_frame(scene_, w.rod().state().positions, gripper, w.gripper().finger_width(), objects_);
     images.steps.push_back(step);
     ++images.frames;
     if (blender_) {
       frames_.push_back(frame);
       return;
     }
-    gl_->render_into(frame, out_);
+    renderer_->render_into(frame, out_);
     images.pixels.insert(images.pixels.end(), out_.rgb.begin(), out_.rgb.end());
   }
 
@@ -103,10 +100,13 @@ class EpisodeImages {
   std::optional<manisoft::render::blender::RunOptions> blender_;
   std::filesystem::path blender_dir_;
   std::vector<manisoft::render::FrameState> frames_;  // Blender: the episode's frames, rendered at its end
-  std::unique_ptr<manisoft::render::GlRenderer> gl_;
+  std::unique_ptr<R> renderer_;
   manisoft::render::tabletop::TabletopScene scene_;
   manisoft::render::RenderOutput out_;
   std::vector<manisoft::math::Pose<double>> objects_;
 };
+
+/// Episode images drawn with the in-process OpenGL renderer (or Blender).
+using EpisodeImages = BasicEpisodeImages<manisoft::render::GlRenderer>;
 
 }  // namespace manisoft_examples

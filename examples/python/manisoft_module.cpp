@@ -216,7 +216,7 @@ class StateRenderer {
 
  private:
   manisoft::scene::SceneSampler sampler_;
-  std::unique_ptr<manisoft::render::GlRenderer> gl_;
+  std::unique_ptr<manisoft_py::PolicyRenderer> gl_;
 };
 
 }  // namespace

@@ -1,7 +1,7 @@
 // The benchmark's task environment for Python: task::TaskEnv (one ManiSoft
 // task COLL/ALN/STK/ARR in the arm world, success predicate, failure reasons) with scenes from
-// scene::SceneSampler, the camera image from the in-process OpenGL renderer (render::GlRenderer
-// over examples/render/spec_render_scene.hpp), and the rule-based expert (task::Expert) for
+// scene::SceneSampler, the camera image from a render::Renderer (PolicyRenderer: the in-process
+// OpenGL renderer) over scene::make_render_scene, and the rule-based expert (task::Expert) for
 // collecting data or as an upper bound. Gymnasium's signatures, no gymnasium dependency.
 //
 // Action (the paper's, section 3.2): one float vector of 3n + 1 entries, the n x 3 material-frame
@@ -27,10 +27,11 @@
 #include <string>
 #include <vector>
 
-#include "../render/spec_render_scene.hpp"
 #include "manisoft/control/action_layout.hpp"
 #include "manisoft/render/gl_renderer.hpp"
+#include "manisoft/render/renderer.hpp"
 #include "manisoft/scene/scene_json.hpp"
+#include "manisoft/scene/scene_render.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/task/expert.hpp"
 #include "manisoft/task/task_env.hpp"
@@ -96,11 +97,11 @@ inline py::array_t<std::uint8_t> image_array(std::vector<std::uint8_t>&& rgb, in
 }
 
 /// The renderer of one scene: its description once, then a frame per state.
+template <ms::render::Renderer R>
 class SceneRenderer {
  public:
-  SceneRenderer(const ms::scene::SceneSpec& spec, const ms::scene::AssetLibrary& library, const std::optional<ms::render::Camera>& camera,
-                ms::render::GlRenderer& gl)
-      : scene_(ms::render::spec::make_spec_scene(spec, library)), gl_(&gl) {
+  SceneRenderer(const ms::scene::SceneSpec& spec, const ms::scene::AssetLibrary& library, const std::optional<ms::render::Camera>& camera, R& gl)
+      : scene_(ms::scene::make_render_scene(spec, library)), gl_(&gl) {
     if (camera) scene_.scene.cameras = {*camera};
     gl_->set_scene(scene_.scene);
   }
@@ -108,7 +109,7 @@ class SceneRenderer {
   /// The frame of a state: rod centreline, gripper body pose and opening, object poses.
   void set_state(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 3>>& rod_nodes, const ms::math::Pose<double>& gripper,
                  double finger_width, const std::vector<ms::math::Pose<double>>& objects) {
-    frame_ = ms::render::spec::task_frame(scene_, rod_nodes, gripper, finger_width, objects);
+    frame_ = ms::scene::render_frame(scene_, rod_nodes, gripper, finger_width, objects);
   }
 
   /// Renders the current frame (the GIL released); the image as a numpy array.
@@ -123,18 +124,16 @@ class SceneRenderer {
 
  private:
   ms::render::tabletop::TabletopScene scene_;
-  ms::render::GlRenderer* gl_;
+  R* gl_;
   ms::render::FrameState frame_;
   ms::render::RenderOutput out_;
 };
 
-/// A GlRenderer for the image a policy sees: shadows on, only colour read back.
-inline std::unique_ptr<ms::render::GlRenderer> make_policy_renderer() {
-  ms::render::GlRendererOptions o;
-  o.read_depth = false;
-  o.read_mask = false;
-  return std::make_unique<ms::render::GlRenderer>(o);
-}
+/// The backend of the image a policy sees (any render::Renderer).
+using PolicyRenderer = ms::render::GlRenderer;
+
+/// A renderer for the image a policy sees: shadows on, only colour read back.
+inline std::unique_ptr<PolicyRenderer> make_policy_renderer() { return ms::render::make_colour_renderer<PolicyRenderer>(); }
 
 class TaskEnvironment {
  public:
@@ -389,8 +388,8 @@ class TaskEnvironment {
   bool render_;
   bool privileged_;
   std::optional<ms::render::Camera> camera_;
-  std::unique_ptr<ms::render::GlRenderer> gl_;
-  std::optional<SceneRenderer> renderer_;
+  std::unique_ptr<PolicyRenderer> gl_;
+  std::optional<SceneRenderer<PolicyRenderer>> renderer_;
   ms::scene::SceneSpec spec_;
   std::string instruction_, instruction_kind_ = "canonical";
   int n_ = 0;

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "blender_run.hpp"
-#include "render_io.hpp"
-#include "tabletop_render_scene.hpp"
+#include "manisoft/render/render_io.hpp"
+#include "manisoft/render/tabletop_render_scene.hpp"
 
 using namespace manisoft::render;
 

@@ -12,13 +12,14 @@
 #include <iostream>
 #include <string>
 
-#include "manisoft/render/gl_renderer.hpp"
 #include "blender_run.hpp"
-#include "render_io.hpp"
-#include "tabletop_render_scene.hpp"
+#include "manisoft/render/gl_renderer.hpp"
+#include "manisoft/render/render_io.hpp"
+#include "manisoft/render/renderer.hpp"
+#include "manisoft/render/tabletop_render_scene.hpp"
 #if MANISOFT_RENDER_SCENES
 #include "manisoft/scene/scene_json.hpp"
-#include "spec_render_scene.hpp"
+#include "manisoft/scene/scene_render.hpp"
 #endif
 
 namespace fs = std::filesystem;
@@ -50,6 +51,39 @@ std::vector<std::uint8_t> strip_image(const std::vector<RenderOutput>& frames, i
   return out;
 }
 
+// Every `every`-th trace row rendered by `renderer` into out/frames/rgb_<k>.png, a strip of up to
+// six of them (strip.png) and, when ffmpeg is installed, out/episode.mp4.
+template <Renderer R>
+void render_episode(R& renderer, const tabletop::TabletopScene& scene, const io::Trace& trace, int every, const fs::path& out) {
+  const fs::path frames_dir = out / "frames";
+  fs::create_directories(frames_dir);
+  std::vector<RenderOutput> strip;
+  std::size_t count = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t strip_every = std::max<std::size_t>(1, trace.rows.size() / static_cast<std::size_t>(every) / 6);
+  for (std::size_t r = 0; r < trace.rows.size(); r += static_cast<std::size_t>(every), ++count) {
+    const RenderOutput image = renderer.render(io::frame_from_trace(scene, trace, r));
+    char name[32];
+    std::snprintf(name, sizeof name, "rgb_%05zu.png", count);
+    write_png_rgb(frames_dir / name, image.width, image.height, image.rgb);
+    if (count % strip_every == 0 && strip.size() < 6) strip.push_back(image);
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  int sw = 0, sh = 0;
+  const auto pixels = strip_image(strip, 2, sw, sh);
+  write_png_rgb(out / "strip.png", sw, sh, pixels);
+  std::printf("%zu frames (every %d-th of %zu rows) in %.2f s -> %s/frames, strip.png\n", count, every, trace.rows.size(), seconds,
+              out.string().c_str());
+  if (std::system("command -v ffmpeg > /dev/null 2>&1") == 0) {
+    const std::string cmd = "ffmpeg -loglevel error -y -framerate 20 -i '" + (frames_dir / "rgb_%05d.png").string() +
+                            "' -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -pix_fmt yuv420p '" + (out / "episode.mp4").string() + "'";
+    if (std::system(cmd.c_str()) == 0) std::printf("video: %s\n", (out / "episode.mp4").string().c_str());
+    else std::fprintf(stderr, "ffmpeg failed: frames are in %s\n", frames_dir.string().c_str());
+  } else {
+    std::printf("ffmpeg not found: no video (frames are in %s)\n", frames_dir.string().c_str());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -78,7 +112,7 @@ int main(int argc, char** argv) {
     if (!scene_path.empty()) {
 #if MANISOFT_RENDER_SCENES
       const manisoft::scene::AssetLibrary library;
-      scene = spec::make_spec_scene(manisoft::scene::load_scene(scene_path, library), library);
+      scene = manisoft::scene::make_render_scene(manisoft::scene::load_scene(scene_path, library), library);
 #else
       manisoft::detail::fail("--scene ", scene_path, ": this build has no scene component (nlohmann-json and the contact component are needed)");
 #endif
@@ -144,33 +178,7 @@ int main(int argc, char** argv) {
                   out.string().c_str());
       return 0;
     }
-    const fs::path frames_dir = out / "frames";
-    fs::create_directories(frames_dir);
-    std::vector<RenderOutput> strip;
-    std::size_t count = 0;
-    const auto t0 = std::chrono::steady_clock::now();
-    const std::size_t strip_every = std::max<std::size_t>(1, trace.rows.size() / static_cast<std::size_t>(every) / 6);
-    for (std::size_t r = 0; r < trace.rows.size(); r += static_cast<std::size_t>(every), ++count) {
-      const RenderOutput image = gl.render(io::frame_from_trace(scene, trace, r));
-      char name[32];
-      std::snprintf(name, sizeof name, "rgb_%05zu.png", count);
-      write_png_rgb(frames_dir / name, image.width, image.height, image.rgb);
-      if (count % strip_every == 0 && strip.size() < 6) strip.push_back(image);
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    int sw = 0, sh = 0;
-    const auto pixels = strip_image(strip, 2, sw, sh);
-    write_png_rgb(out / "strip.png", sw, sh, pixels);
-    std::printf("%zu frames (every %d-th of %zu rows) in %.2f s -> %s/frames, strip.png\n", count, every, trace.rows.size(), seconds,
-                out.string().c_str());
-    if (std::system("command -v ffmpeg > /dev/null 2>&1") == 0) {
-      const std::string cmd = "ffmpeg -loglevel error -y -framerate 20 -i '" + (frames_dir / "rgb_%05d.png").string() +
-                              "' -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -pix_fmt yuv420p '" + (out / "episode.mp4").string() + "'";
-      if (std::system(cmd.c_str()) == 0) std::printf("video: %s\n", (out / "episode.mp4").string().c_str());
-      else std::fprintf(stderr, "ffmpeg failed: frames are in %s\n", frames_dir.string().c_str());
-    } else {
-      std::printf("ffmpeg not found: no video (frames are in %s)\n", frames_dir.string().c_str());
-    }
+    render_episode(gl, scene, trace, every, out);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "render_scene: %s\n", e.what());

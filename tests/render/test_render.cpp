@@ -4,18 +4,22 @@
 
 #include "../support/scratch_dir.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 #include "manisoft/core/error.hpp"
 #include "manisoft/render/gl_renderer.hpp"
 #include "manisoft/render/image.hpp"
 #include "manisoft/render/mesh_builders.hpp"
 #include "manisoft/render/renderer.hpp"
-#include "tabletop_render_scene.hpp"
+#include "manisoft/render/tabletop_render_scene.hpp"
 
 using namespace manisoft::render;
 using Catch::Matchers::Contains;
@@ -438,4 +442,89 @@ TEST_CASE("incremental frames are the full redraws, pixel for pixel, and redraw 
     incremental.render_into(episode_frame(t, 17), b);
     CHECK(incremental.last_draw().everything);  // a new scene draws everything
   }
+}
+
+TEST_CASE("the projection is within half a pixel on a non-square image", "[render]") {
+  // A camera 2 m above the origin looking straight down, 320 x 200 pixels, 60 degree vertical field
+  // of view: right = forward x up = (0, 0, -1) x (0, 1, 0) = (1, 0, 0), down = forward x right =
+  // (0, -1, 0), f = (200 / 2) / tan(30 deg) = 100 sqrt(3), principal point ((320 - 1) / 2,
+  // (200 - 1) / 2) = (159.5, 99.5). A point (X, Y, 0) (depth 2) lands at u = 159.5 + f X / 2,
+  // v = 99.5 - f Y / 2.
+  const double f = 100.0 * std::sqrt(3.0), half = 0.05, depth = 2.0;
+  SceneDescription s;
+  s.materials.push_back(Material{});
+  // A square marker facing up (+z), 10 cm a side, as two counter-clockwise triangles.
+  Mesh square;
+  for (const auto& [x, y] : {std::pair{-half, -half}, std::pair{half, -half}, std::pair{half, half}, std::pair{-half, half}}) {
+    square.positions.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0f);
+    square.normals.emplace_back(0.0f, 0.0f, 1.0f);
+    square.uvs.emplace_back(0.0f, 0.0f);
+  }
+  square.indices = {0, 1, 2, 0, 2, 3};
+  s.meshes.push_back(square);
+  Camera c;
+  c.position = {0.0, 0.0, depth};
+  c.look_at = {0.0, 0.0, 0.0};
+  c.up = {0.0, 1.0, 0.0};
+  c.fov_y_deg = 60.0;
+  c.width = 320;
+  c.height = 200;
+  s.cameras = {c};
+  s.rod.present = false;
+  // Markers over the whole image (near its left and right ends too), edges at many sub-pixel offsets.
+  FrameState frame;
+  std::vector<Eigen::Vector2d> centres;
+  for (const double x : {-1.5, -0.73, 0.0, 0.41, 1.62}) {
+    for (const double y : {-0.9, 0.27, 0.88}) centres.emplace_back(x, y);
+  }
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    s.instances.push_back(Instance{0, 0, static_cast<std::uint16_t>(i + 1), "marker", true});
+    frame.instance_poses.push_back(at(centres[i].x(), centres[i].y(), 0.0));
+  }
+  GlRenderer& gl = renderer();
+  gl.set_scene(s);
+  const RenderOutput out = gl.render(frame);
+  REQUIRE(out.width == 320);
+  REQUIRE(out.height == 200);
+  // The camera's calibration is the hand computation.
+  CHECK(out.camera.K(0, 0) == Approx(f));
+  CHECK(out.camera.K(1, 1) == Approx(f));
+  CHECK(out.camera.K(0, 2) == Approx(159.5));
+  CHECK(out.camera.K(1, 2) == Approx(99.5));
+  double worst = 0;
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    const auto id = static_cast<std::uint16_t>(i + 1);
+    const double X = centres[i].x(), Y = centres[i].y();
+    // Edges by hand: left, right (u) and top, bottom (v).
+    const double left = 159.5 + f * (X - half) / depth, right = 159.5 + f * (X + half) / depth;
+    const double top = 99.5 - f * (Y + half) / depth, bottom = 99.5 - f * (Y - half) / depth;
+    CHECK((out.camera.project(Eigen::Vector3d(X - half, Y + half, 0)) - Eigen::Vector2d(left, top)).norm() < 1e-9);
+    CHECK((out.camera.project(Eigen::Vector3d(X + half, Y - half, 0)) - Eigen::Vector2d(right, bottom)).norm() < 1e-9);
+    // The rendered marker: the pixels with its id form the rectangle [u0, u1] x [v0, v1]; its edges
+    // lie half a pixel outside the outermost pixel centres.
+    int u0 = out.width, u1 = -1, v0 = out.height, v1 = -1, count = 0;
+    for (int v = 0; v < out.height; ++v) {
+      for (int u = 0; u < out.width; ++u) {
+        if (out.id_at(u, v) != id) continue;
+        u0 = std::min(u0, u);
+        u1 = std::max(u1, u);
+        v0 = std::min(v0, v);
+        v1 = std::max(v1, v);
+        ++count;
+      }
+    }
+    INFO("marker " << id << " at (" << X << ", " << Y << "): by hand u in [" << left << ", " << right << "], v in [" << top << ", " << bottom
+                   << "]; rendered columns " << u0 << ".." << u1 << ", rows " << v0 << ".." << v1);
+    REQUIRE(u1 >= u0);
+    CHECK(count == (u1 - u0 + 1) * (v1 - v0 + 1));
+    for (const double error : {(u0 - 0.5) - left, (u1 + 0.5) - right, (v0 - 0.5) - top, (v1 + 0.5) - bottom}) {
+      CHECK(std::abs(error) <= 0.5);
+      worst = std::max(worst, std::abs(error));
+    }
+    // Depth at the marker's centre pixel: 2 m.
+    const Eigen::Vector2d centre = out.camera.project(Eigen::Vector3d(X, Y, 0));
+    CHECK(out.depth_at(static_cast<int>(std::lround(centre.x())), static_cast<int>(std::lround(centre.y()))) == Approx(depth).margin(1e-3));
+  }
+  INFO("worst edge error " << worst << " px");
+  CHECK(worst <= 0.5);
 }

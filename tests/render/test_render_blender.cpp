@@ -13,7 +13,7 @@
 
 #include "blender_run.hpp"
 #include "manisoft/render/gl_renderer.hpp"
-#include "tabletop_render_scene.hpp"
+#include "manisoft/render/tabletop_render_scene.hpp"
 
 using namespace manisoft::render;
 

@@ -1,8 +1,10 @@
-// The renderer interface: a Renderer takes a SceneDescription once and a
-// FrameState per frame and returns a RenderOutput (RGB, depth, object-id mask and the camera's
-// OpenCV calibration). GlRenderer (gl_renderer.hpp) is the in-process one; the Blender adapter
-// (blender_export.hpp) renders the same snapshots offline. Also: each object's world bounding
-// box for a frame (what camera.json lists per id), and the gripper's part poses from its frame.
+// The renderer interface: a Renderer takes a SceneDescription once and a FrameState per frame and
+// returns a RenderOutput (RGB, depth, object-id mask and the camera's OpenCV calibration). Code
+// that draws frames is written against the concept, so that a backend is one header defining a
+// type that satisfies it. GlRenderer (gl_renderer.hpp) is the in-process one; the Blender adapter
+// (blender_export.hpp) renders the same snapshots offline, in batches. Also: each object's world
+// bounding box for a frame (what camera.json lists per id), and the gripper's part poses from its
+// frame.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,6 +16,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "manisoft/render/image.hpp"
@@ -21,12 +24,29 @@
 
 namespace manisoft::render {
 
-/// What every renderer provides.
+/// What every renderer backend provides: its options (R::Options, which say at least whether
+/// depth and ids are read back), construction from them, set_scene() once, then per frame
+/// render() or render_into() (the same image into a RenderOutput whose buffers are reused).
 template <typename R>
-concept Renderer = requires(R renderer, const SceneDescription& scene, const FrameState& frame, std::size_t camera) {
-  renderer.set_scene(scene);
-  { renderer.render(frame, camera) } -> std::same_as<RenderOutput>;
-};
+concept Renderer = std::constructible_from<R, const typename R::Options&> &&
+                   requires(R renderer, typename R::Options options, const SceneDescription& scene, const FrameState& frame, std::size_t camera,
+                            RenderOutput& out) {
+                     options.read_depth = false;
+                     options.read_mask = false;
+                     renderer.set_scene(scene);
+                     { renderer.render(frame, camera) } -> std::same_as<RenderOutput>;
+                     renderer.render_into(frame, out, camera);
+                   };
+
+/// A renderer that reads back colour only (no depth, no ids), its other options the defaults:
+/// the image a policy sees.
+template <Renderer R>
+std::unique_ptr<R> make_colour_renderer() {
+  typename R::Options options;
+  options.read_depth = false;
+  options.read_mask = false;
+  return std::make_unique<R>(options);
+}
 
 /// An object's name and world axis-aligned bounding box in one frame.
 struct ObjectBounds {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "manisoft/core/error.hpp"
 #include "manisoft/math/se3.hpp"
 #include "manisoft/render/camera.hpp"
 
@@ -116,5 +117,45 @@ struct FrameState {
   RodShape rod;                                    ///< drawn when nodes has >= 2 rows and the scene's rod is present
   std::optional<math::Pose<double>> goal_pose;
 };
+
+/// Checks a scene (cameras, mesh indices and normals, instance meshes, materials and ids, the
+/// rod's material, the lighting) and throws manisoft::Error naming the bad value and its limit.
+inline void validate(const SceneDescription& scene) {
+  if (scene.cameras.empty()) manisoft::detail::fail("SceneDescription: no camera: at least one is needed");
+  for (const Camera& c : scene.cameras) validate(c);
+  if (scene.materials.empty()) manisoft::detail::fail("SceneDescription: no material: at least one is needed");
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    const Mesh& m = scene.meshes[i];
+    if (m.normals.size() != m.positions.size()) {
+      manisoft::detail::fail("SceneDescription mesh ", i, ": ", m.normals.size(), " normals for ", m.positions.size(), " positions");
+    }
+    if (m.indices.size() % 3 != 0) manisoft::detail::fail("SceneDescription mesh ", i, ": ", m.indices.size(), " indices is not a multiple of 3");
+    for (std::uint32_t idx : m.indices) {
+      if (idx >= m.positions.size()) manisoft::detail::fail("SceneDescription mesh ", i, ": index ", idx, " >= vertex count ", m.positions.size());
+    }
+  }
+  for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    if (inst.mesh < 0 || static_cast<std::size_t>(inst.mesh) >= scene.meshes.size()) {
+      manisoft::detail::fail("SceneDescription instance ", i, " (", inst.name, "): mesh = ", inst.mesh, " out of range [0, ", scene.meshes.size(), ")");
+    }
+    if (inst.material < 0 || static_cast<std::size_t>(inst.material) >= scene.materials.size()) {
+      manisoft::detail::fail("SceneDescription instance ", i, " (", inst.name, "): material = ", inst.material, " out of range [0, ",
+                             scene.materials.size(), ")");
+    }
+    if (inst.object_id == 0) manisoft::detail::fail("SceneDescription instance ", i, " (", inst.name, "): object_id 0 is reserved for the background");
+  }
+  if (scene.rod.present && (scene.rod.material < 0 || static_cast<std::size_t>(scene.rod.material) >= scene.materials.size())) {
+    manisoft::detail::fail("SceneDescription rod: material = ", scene.rod.material, " out of range [0, ", scene.materials.size(), ")");
+  }
+  const Lighting& l = scene.lighting;
+  if (!(l.direction.norm() > 0) || !l.direction.allFinite()) manisoft::detail::fail("Lighting direction must be finite and non-zero");
+  if (l.kind == LightKind::spot && !(l.spot_cone_deg > 0 && l.spot_cone_deg <= 80)) {
+    manisoft::detail::fail("Lighting spot_cone_deg = ", l.spot_cone_deg, " is invalid: it must lie in (0, 80]");
+  }
+  manisoft::detail::require_positive("Lighting shadow_radius", l.shadow_radius);
+  manisoft::detail::require_non_negative("Lighting intensity", l.intensity);
+  manisoft::detail::require_non_negative("Lighting ambient_intensity", l.ambient_intensity);
+}
 
 }  // namespace manisoft::render

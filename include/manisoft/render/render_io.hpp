@@ -18,7 +18,7 @@
 #include "manisoft/core/error.hpp"
 #include "manisoft/render/image.hpp"
 #include "manisoft/render/renderer.hpp"
-#include "tabletop_render_scene.hpp"
+#include "manisoft/render/tabletop_render_scene.hpp"
 
 namespace manisoft::render::io {
 

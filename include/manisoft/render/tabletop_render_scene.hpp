@@ -1,4 +1,4 @@
-// The built-in tabletop scene of render_scene, from plain data (no physics headers): table,
+// The built-in tabletop scene of the render programs, from plain data (no physics headers): table,
 // floor, arm mount, the soft arm (a 1 m rod of radius 5 cm, 20 elements), the parallel gripper
 // and eight objects, in the ManiSoft world frame (z up, floor at z = 0, table top x in [0, 0.8],
 // y in [-0.5, 0.5] at z = 0.75 m; the arm's base at (-0.05, 0, 1.5) pointing +x). Shared by
@@ -112,13 +112,14 @@ inline math::Pose<double> gripper_at_tip(const RodShape& rod) {
   return pose;
 }
 
-/// The built-in scene and its static frame.
-inline TabletopScene make_tabletop_scene() {
-  TabletopScene t;
-  SceneDescription& s = t.scene;
-  FrameState& f = t.frame;
-  auto material = [&](Eigen::Vector3f base, TextureKind kind = TextureKind::none, Eigen::Vector3f secondary = {0, 0, 0}, float scale = 10.0f,
-                      float specular = 0.2f, float shininess = 32.0f) {
+namespace detail {
+
+/// Adds materials, meshes and instances (with their poses in the static frame) to a scene.
+struct SceneBuilder {
+  TabletopScene& t;
+
+  int material(Eigen::Vector3f base, TextureKind kind = TextureKind::none, Eigen::Vector3f secondary = {0, 0, 0}, float scale = 10.0f,
+               float specular = 0.2f, float shininess = 32.0f) {
     Material m;
     m.base_color = base;
     m.texture = kind;
@@ -126,79 +127,98 @@ inline TabletopScene make_tabletop_scene() {
     m.texture_scale = scale;
     m.specular = specular;
     m.shininess = shininess;
-    s.materials.push_back(m);
-    return static_cast<int>(s.materials.size() - 1);
-  };
-  auto mesh = [&](Mesh m) {
-    s.meshes.push_back(std::move(m));
-    return static_cast<int>(s.meshes.size() - 1);
-  };
-  auto instance = [&](int mesh_index, int material_index, std::uint16_t id, std::string name, const math::Pose<double>& pose, bool casts_shadow = true) {
-    s.instances.push_back(Instance{mesh_index, material_index, id, std::move(name), casts_shadow});
-    f.instance_poses.push_back(pose);
-    return s.instances.size() - 1;
-  };
+    t.scene.materials.push_back(m);
+    return static_cast<int>(t.scene.materials.size() - 1);
+  }
+  int mesh(Mesh m) {
+    t.scene.meshes.push_back(std::move(m));
+    return static_cast<int>(t.scene.meshes.size() - 1);
+  }
+  std::size_t instance(int mesh_index, int material_index, std::uint16_t id, std::string name, const math::Pose<double>& pose, bool casts_shadow = true) {
+    t.scene.instances.push_back(Instance{mesh_index, material_index, id, std::move(name), casts_shadow});
+    t.frame.instance_poses.push_back(pose);
+    return t.scene.instances.size() - 1;
+  }
+};
 
+/// Floor, table, arm mount and the gripper's parts.
+inline void add_fixtures(SceneBuilder& b) {
+  TabletopScene& t = b.t;
   // Floor: grey checker tiles, 6 x 6 m, top at z = 0; not a shadow caster (cheaper shadow pass).
-  const int floor_material = material({0.55f, 0.55f, 0.53f}, TextureKind::checker, {0.42f, 0.42f, 0.41f}, 2.0f, 0.05f);
-  instance(mesh(make_box({3.0, 3.0, 0.005})), floor_material, floor_id, "floor", at(0.4, 0, -0.005), false);
+  const int floor_material = b.material({0.55f, 0.55f, 0.53f}, TextureKind::checker, {0.42f, 0.42f, 0.41f}, 2.0f, 0.05f);
+  b.instance(b.mesh(make_box({3.0, 3.0, 0.005})), floor_material, floor_id, "floor", at(0.4, 0, -0.005), false);
 
   // Table: wooden top 0.8 x 1.0 x 0.05 m (top face at 0.75) on four legs.
   Mesh table = make_box({0.4, 0.5, 0.025});
   for (double lx : {-0.36, 0.36}) {
     for (double ly : {-0.46, 0.46}) append(table, make_box({0.025, 0.025, 0.35}), at(lx, ly, -0.375));
   }
-  const int wood = material({0.62f, 0.42f, 0.24f}, TextureKind::wood, {0.42f, 0.26f, 0.13f}, 30.0f, 0.15f, 24.0f);
-  instance(mesh(std::move(table)), wood, table_id, "table", at(0.4, 0, 0.725));
+  const int wood = b.material({0.62f, 0.42f, 0.24f}, TextureKind::wood, {0.42f, 0.26f, 0.13f}, 30.0f, 0.15f, 24.0f);
+  b.instance(b.mesh(std::move(table)), wood, table_id, "table", at(0.4, 0, 0.725));
 
   // Arm mount: a grey post from the floor to a block holding the rod's base.
   Mesh mount = make_box({0.06, 0.06, 0.06});
   append(mount, make_box({0.03, 0.03, 0.72}), at(-0.03, 0, -0.78));
-  const int metal = material({0.35f, 0.36f, 0.38f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.5f, 48.0f);
-  instance(mesh(std::move(mount)), metal, mount_id, "mount", at(-0.11, 0, 1.5));
+  const int metal = b.material({0.35f, 0.36f, 0.38f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.5f, 48.0f);
+  b.instance(b.mesh(std::move(mount)), metal, mount_id, "mount", at(-0.11, 0, 1.5));
 
   // Gripper: palm and two fingers (dark grey), one id.
-  const int gripper_material = material({0.18f, 0.19f, 0.21f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.5f, 64.0f);
-  t.palm = instance(mesh(make_box(t.gripper.palm_half_extents)), gripper_material, gripper_id, "gripper", {});
-  const int finger_mesh = mesh(make_box(t.gripper.finger_half_extents));
-  t.left_finger = instance(finger_mesh, gripper_material, gripper_id, "gripper", {});
-  t.right_finger = instance(finger_mesh, gripper_material, gripper_id, "gripper", {});
+  const int gripper_material = b.material({0.18f, 0.19f, 0.21f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.5f, 64.0f);
+  t.palm = b.instance(b.mesh(make_box(t.gripper.palm_half_extents)), gripper_material, gripper_id, "gripper", {});
+  const int finger_mesh = b.mesh(make_box(t.gripper.finger_half_extents));
+  t.left_finger = b.instance(finger_mesh, gripper_material, gripper_id, "gripper", {});
+  t.right_finger = b.instance(finger_mesh, gripper_material, gripper_id, "gripper", {});
+}
 
-  // Objects on the table top (z = 0.75), in world_demo's order.
+/// The eight objects on the table top (z = 0.75), in world_demo's order.
+inline void add_objects(SceneBuilder& b) {
+  TabletopScene& t = b.t;
   const double top = 0.75;
   const double pi = std::numbers::pi;
   t.object_instance["cube"] =
-      instance(mesh(make_box({0.025, 0.025, 0.025})), material({0.85f, 0.12f, 0.10f}), cube_id, "cube", at(0.55, 0.0, top + 0.025));
-  t.object_instance["block"] = instance(mesh(make_box({0.04, 0.03, 0.02})),
-                                        material({0.15f, 0.35f, 0.80f}, TextureKind::noise, {0.08f, 0.2f, 0.55f}, 40.0f), block_id, "block",
-                                        at(0.25, -0.35, top + 0.02));
-  t.object_instance["carton"] = instance(mesh(make_box({0.06, 0.04, 0.05})),
-                                         material({0.72f, 0.58f, 0.38f}, TextureKind::fabric, {0.55f, 0.42f, 0.26f}, 60.0f, 0.05f), carton_id,
-                                         "carton", at(0.62, -0.40, top + 0.05));
-  t.object_instance["can"] = instance(mesh(make_cylinder(0.033, 0.06)), material({0.80f, 0.80f, 0.82f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.8f, 80.0f),
-                                      can_id, "can", at(0.25, 0.35, top + 0.06));
-  t.object_instance["bottle"] = instance(mesh(make_cylinder(0.03, 0.10)), material({0.10f, 0.55f, 0.25f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.6f, 64.0f),
-                                         bottle_id, "bottle", at(0.68, 0.40, top + 0.10));
-  t.object_instance["ball"] = instance(mesh(make_sphere(0.035)), material({0.95f, 0.78f, 0.10f}, TextureKind::noise, {0.85f, 0.45f, 0.05f}, 25.0f),
-                                       ball_id, "ball", at(0.45, -0.28, top + 0.035));
+      b.instance(b.mesh(make_box({0.025, 0.025, 0.025})), b.material({0.85f, 0.12f, 0.10f}), cube_id, "cube", at(0.55, 0.0, top + 0.025));
+  t.object_instance["block"] = b.instance(b.mesh(make_box({0.04, 0.03, 0.02})),
+                                          b.material({0.15f, 0.35f, 0.80f}, TextureKind::noise, {0.08f, 0.2f, 0.55f}, 40.0f), block_id, "block",
+                                          at(0.25, -0.35, top + 0.02));
+  t.object_instance["carton"] = b.instance(b.mesh(make_box({0.06, 0.04, 0.05})),
+                                           b.material({0.72f, 0.58f, 0.38f}, TextureKind::fabric, {0.55f, 0.42f, 0.26f}, 60.0f, 0.05f), carton_id,
+                                           "carton", at(0.62, -0.40, top + 0.05));
+  t.object_instance["can"] = b.instance(b.mesh(make_cylinder(0.033, 0.06)),
+                                        b.material({0.80f, 0.80f, 0.82f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.8f, 80.0f), can_id, "can",
+                                        at(0.25, 0.35, top + 0.06));
+  t.object_instance["bottle"] = b.instance(b.mesh(make_cylinder(0.03, 0.10)),
+                                           b.material({0.10f, 0.55f, 0.25f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.6f, 64.0f), bottle_id, "bottle",
+                                           at(0.68, 0.40, top + 0.10));
+  t.object_instance["ball"] = b.instance(b.mesh(make_sphere(0.035)), b.material({0.95f, 0.78f, 0.10f}, TextureKind::noise, {0.85f, 0.45f, 0.05f}, 25.0f),
+                                         ball_id, "ball", at(0.45, -0.28, top + 0.035));
   math::Pose<double> marker = at(0.45, 0.30, top + 0.02);
   marker.rotation = Eigen::AngleAxisd(pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  t.object_instance["marker"] = instance(mesh(make_capsule(0.02, 0.06)), material({0.50f, 0.20f, 0.65f}), marker_id, "marker", marker);
-  t.object_instance["bowl"] = instance(mesh(make_vessel(0.05, 0.05, 0.004, 40.0 * pi / 180.0)),
-                                       material({0.92f, 0.92f, 0.90f}, TextureKind::marble, {0.45f, 0.47f, 0.52f}, 25.0f, 0.5f, 64.0f), bowl_id,
-                                       "bowl", at(0.10, -0.30, top));
+  t.object_instance["marker"] = b.instance(b.mesh(make_capsule(0.02, 0.06)), b.material({0.50f, 0.20f, 0.65f}), marker_id, "marker", marker);
+  t.object_instance["bowl"] = b.instance(b.mesh(make_vessel(0.05, 0.05, 0.004, 40.0 * pi / 180.0)),
+                                         b.material({0.92f, 0.92f, 0.90f}, TextureKind::marble, {0.45f, 0.47f, 0.52f}, 25.0f, 0.5f, 64.0f), bowl_id,
+                                         "bowl", at(0.10, -0.30, top));
+}
 
+}  // namespace detail
+
+/// The built-in scene and its static frame.
+inline TabletopScene make_tabletop_scene() {
+  TabletopScene t;
+  detail::SceneBuilder b{t};
+  detail::add_fixtures(b);
+  detail::add_objects(b);
   // The soft arm: silicone orange, its base at (-0.05, 0, 1.5) pointing +x, bent 85 degrees down
   // in a plane rolled 20 degrees sideways (seen from the front camera it reads as a curved tube).
-  s.rod.material = material({0.93f, 0.50f, 0.18f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.35f, 32.0f);
-  s.rod.object_id = arm_id;
-  s.rod.name = "arm";
-  f.rod = arc_rod(Eigen::Vector3d(-0.05, 0, 1.5), 1.0, 20, 85.0 * pi / 180.0, 0.05, -20.0 * pi / 180.0);
-  set_gripper(t, f, gripper_at_tip(f.rod), 0.10);
+  const double pi = std::numbers::pi;
+  t.scene.rod.material = b.material({0.93f, 0.50f, 0.18f}, TextureKind::none, {0, 0, 0}, 10.0f, 0.35f, 32.0f);
+  t.scene.rod.object_id = arm_id;
+  t.scene.rod.name = "arm";
+  t.frame.rod = arc_rod(Eigen::Vector3d(-0.05, 0, 1.5), 1.0, 20, 85.0 * pi / 180.0, 0.05, -20.0 * pi / 180.0);
+  set_gripper(t, t.frame, gripper_at_tip(t.frame.rod), 0.10);
 
-  s.goal_marker.object_id = goal_id;
-  s.goal_marker.name = "goal";
-  s.cameras = {Camera{}};
+  t.scene.goal_marker.object_id = goal_id;
+  t.scene.goal_marker.name = "goal";
+  t.scene.cameras = {Camera{}};
   return t;
 }
 
