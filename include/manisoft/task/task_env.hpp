@@ -72,7 +72,7 @@ struct TaskEnvConfig {
   /// environment's defaults with twice its node velocity feedback (kd 70 /s against 35): with a
   /// held object, an object under the fingers and fast lines the arm sways after every path for
   /// about 100 control steps at kd 35, which costs the expert's settling waits their time and
-  /// sets objects down swinging (BENCHMARKS.md, "Expert episodes").
+  /// sets objects down swinging.
   control::ModelExecutorSettings<double> executor = task_executor_settings();
 
   static control::ModelExecutorSettings<double> task_executor_settings() {
