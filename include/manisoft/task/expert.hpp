@@ -100,7 +100,7 @@ struct ExpertConfig {
   double max_node_speed = 1.5;      ///< m/s, planned peak speed of any rod node (gripper empty)
   double carry_peak_speed = 1.5;    ///< m/s, the same while an object is held (its acceleration bounded by carry_grip_share)
   double carry_node_speed = 1.5;    ///< m/s
-  double carry_grip_share = 0.45;   ///< a held line's planned peak acceleration at most this share of what the grip holds (max_hold_force / mass; 0: not bounded): a short lift at the carry's speed accelerated a tall bottle at about 10 g, past the grip's 40 N
+  double carry_grip_share = 0.45;   ///< a held line's planned peak acceleration at most this share of what the grip holds (max_hold_force / mass; 0: not bounded): a short lift at the carry's full speed can accelerate a tall object past what the grip holds
   double path_cruise = 0.7;         ///< fraction of a path at constant speed (0: quintic timing; ModelExecutor::track_line)
   int min_segment_steps = 60;       ///< shortest path, control steps
   double settle_speed = 0.15;       ///< m/s: close / open only when the arm's tip is slower

@@ -69,10 +69,9 @@ struct TaskEnvConfig {
   double time_to_sleep = 0.1;
   Tolerances tolerances{};
   /// The executor the expert (and any model-based policy) uses in the task world: the reach
-  /// environment's defaults with twice its node velocity feedback (kd 70 /s against 35): with a
-  /// held object, an object under the fingers and fast lines the arm sways after every path for
-  /// about 100 control steps at kd 35, which costs the expert's settling waits their time and
-  /// sets objects down swinging.
+  /// environment's defaults with twice its node velocity feedback (kd 70 /s): with a held object
+  /// and fast lines, the reach environment's gain leaves the arm swaying after every path, which
+  /// costs the expert's settling waits their time and sets objects down swinging.
   control::ModelExecutorSettings<double> executor = task_executor_settings();
 
   static control::ModelExecutorSettings<double> task_executor_settings() {
