@@ -33,6 +33,7 @@
 #include <thread>
 #include <vector>
 
+#include "../cli_checks.hpp"
 #include "episode_images.hpp"
 #include "manisoft/dataset/dataset_index.hpp"
 #include "manisoft/dataset/expert_recording.hpp"
@@ -154,6 +155,8 @@ int main(int argc, char** argv) {
   app.add_option("--jobs", jobs, "worker threads")->check(CLI::Range(1, 256));
   app.add_option("--max-draws", plan.max_draws, "scene draws per episode before giving up")->check(CLI::Range(1, 100000));
   app.add_flag("--index-only", index_only, "only write the index (after every shard is done)");
+  manisoft::cli::check_counts(app, {"--clean", "--randomized", "--seed"});
+  manisoft::cli::readable_errors(app, "generate_dataset");
   CLI11_PARSE(app, argc, argv);
   try {
     plan.tasks = parse_tasks(tasks);
