@@ -157,7 +157,7 @@ int main(int argc, char** argv) {
   app.add_flag("--index-only", index_only, "only write the index (after every shard is done)");
   manisoft::cli::check_counts(app, {"--clean", "--randomized", "--seed"});
   manisoft::cli::readable_errors(app, "generate_dataset");
-  CLI11_PARSE(app, argc, argv);
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
     plan.tasks = parse_tasks(tasks);
     long shard_i = 0, shard_n = 1;

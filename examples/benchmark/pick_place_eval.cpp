@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   app.add_option("--object", object, "cube (5 cm) or can (r 3.3 cm, lying on its side)")->check(CLI::IsMember({"cube", "can"}));
   app.add_option("--out", out, "per-episode CSV")->required();
   manisoft::cli::readable_errors(app, "pick_place_eval");
-  CLI11_PARSE(app, argc, argv);
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
     manisoft::cli::OutputFile file(out);
     std::ostream& csv = file.stream();

@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
   app.add_option("--executor-stiffness", env_config.executor.position_gain, "executor: node position feedback kp, 1/s^2")->check(manisoft::cli::non_negative());
   manisoft::cli::check_counts(app, {"--index", "--seed"});
   manisoft::cli::readable_errors(app, "run_task");
-  CLI11_PARSE(app, argc, argv);
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   expert_config.check_arm_clearance = !no_arm_check;
   try {
     const std::clock_t c0 = std::clock();

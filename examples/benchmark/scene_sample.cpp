@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "scene JSON file to write")->required();
   app.add_flag("--quiet", quiet, "print nothing on success");
   manisoft::cli::readable_errors(app, "scene_sample");
-  CLI11_PARSE(app, argc, argv);
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
     scene::SampleRequest q;
     q.task = scene::parse_task(task);
