@@ -3,8 +3,8 @@
 // reached the file system; a run that fails half-way (a bad value met on the way, a diverged
 // simulation, a full disk) leaves no file that looks complete, and a write error is an error that
 // names the file. Devices and pipes (/dev/stdout, /dev/full, a FIFO) are written in place, as
-// they cannot be renamed onto. OutputFolder removes a folder the program created if the program
-// fails before keep().
+// they cannot be renamed onto. OutputFolder removes the folders the program created (the output
+// folder and any new parents) if the program fails before keep().
 #pragma once
 
 #include <cerrno>
@@ -71,7 +71,10 @@ class OutputFolder {
   /// Creates `path` (and its parents) if missing; throws manisoft::Error naming it on failure.
   explicit OutputFolder(std::filesystem::path path) : path_(std::move(path)) {
     std::error_code ec;
-    created_ = !std::filesystem::exists(path_, ec);
+    for (auto p = path_; !p.empty() && !std::filesystem::exists(p, ec); p = p.parent_path()) {
+      created_ = p;  // the outermost folder that is new
+      if (p == p.parent_path()) break;
+    }
     std::filesystem::create_directories(path_, ec);
     if (ec) manisoft::detail::fail("cannot create the folder '", path_.string(), "': ", ec.message());
   }
@@ -79,14 +82,14 @@ class OutputFolder {
   OutputFolder& operator=(const OutputFolder&) = delete;
   ~OutputFolder() {
     std::error_code ignored;
-    if (created_ && !kept_) std::filesystem::remove_all(path_, ignored);
+    if (!created_.empty() && !kept_) std::filesystem::remove_all(created_, ignored);
   }
   const std::filesystem::path& path() const { return path_; }
   void keep() { kept_ = true; }
 
  private:
-  std::filesystem::path path_;
-  bool created_ = false, kept_ = false;
+  std::filesystem::path path_, created_;  // created_: empty when the folder was there before
+  bool kept_ = false;
 };
 
 }  // namespace manisoft::cli
