@@ -150,6 +150,10 @@ def scene_cases():
     # one scene drawn at another scene's trace: ARR's objects are not ALN's
     arr_trace = trace_of(arr, scratch("arr.csv"))
     refused(render_scene, ["--scene", aln, "--trace", arr_trace, "--out", images], [arr_trace, "recorded in another scene"], [images])
+    # a frame that fails to draw (a zero quaternion) after the output folder was made: the new folders go again
+    zero = edited(arr_trace, scratch("zero_quaternion.csv"), r"(\n(?:[^,]*,){9})0,1,0,0,", r"\g<1>0,0,0,0,")  # gripper_qw..qz
+    nested = os.path.join(SCRATCH, "new", "images")
+    refused(render_scene, ["--scene", arr, "--trace", zero, "--out", nested], ["quaternion of 'gripper' has zero norm"], [os.path.dirname(nested)], 1)
     accepted(render_scene, ["--scene", arr, "--trace", arr_trace, "--out", images])
     if render_scene and not os.path.exists(os.path.join(images, "rgb.png")):
         failures.append("render_scene --scene arr.json --trace arr.csv wrote no rgb.png")
