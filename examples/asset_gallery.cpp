@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_checks.hpp"
 #include "manisoft/assets/asset_view.hpp"
 #include "manisoft/assets/catalog.hpp"
 #ifdef MANISOFT_HAVE_RENDER
@@ -145,12 +146,13 @@ int main(int argc, char** argv) {
   app.add_flag("--markdown", markdown, "print the category table as Markdown");
   app.add_option("--export", export_dir, "write every visual mesh as an OBJ file into this folder");
   app.add_option("--contact-sheet", sheet_path, "render every asset into this PNG (legend: the same name with .csv)");
-  app.add_option("--columns", columns, "contact sheet: tiles a row")->check(CLI::Range(1, 100));
-  app.add_option("--tile", tile, "contact sheet: rendered tile size, pixels")->check(CLI::Range(16, 1024));
+  app.add_option("--columns", columns, "contact sheet: tiles a row")->check(manisoft::cli::between(1, 100));
+  app.add_option("--tile", tile, "contact sheet: rendered tile size, pixels")->check(manisoft::cli::between(16, 1024));
   app.add_option("--msaa", msaa, "contact sheet: OpenGL multisampling (0, 2, 4, 8)")->check(CLI::IsMember({0, 2, 4, 8}));
-  app.add_option("--downscale", downscale, "contact sheet: box-filter each tile down by this factor")->check(CLI::Range(1, 8));
+  app.add_option("--downscale", downscale, "contact sheet: box-filter each tile down by this factor")->check(manisoft::cli::between(1, 8));
   app.add_option("--levels", levels, "contact sheet: quantize each colour channel to this many levels (smaller PNG)")
-      ->check(CLI::Range(2, 256));
+      ->check(manisoft::cli::between(2, 256));
+  manisoft::cli::readable_errors(app, "asset_gallery");
   CLI11_PARSE(app, argc, argv);
   try {
     using namespace manisoft::assets;

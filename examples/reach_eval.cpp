@@ -27,6 +27,9 @@
 // substep (m/s) and the tip path ratio, the end-effector's path from the end of the first control
 // step to the first step of the held window (to the horizon if none) over the straight distance
 // from there to the target.
+// --help lists the flags. Bad flags exit 2 with a message naming the flag and the value (the
+// load at most the bend limit over g times the arm's length); a refused configuration or a failed
+// write exits 1, leaving no CSV (written under a temporary name, renamed when complete).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -37,11 +40,13 @@
 #include <string>
 #include <vector>
 
+#include "cli_checks.hpp"
 #include "manisoft/control/mlp_executor.hpp"
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/control/projected_executor.hpp"
 #include "manisoft/env/reach_env.hpp"
 #include "manisoft/env/rollout.hpp"
+#include "output_file.hpp"
 
 namespace {
 
@@ -54,11 +59,7 @@ struct Options {
 };
 
 [[noreturn]] void usage_error(const std::string& message) {
-  std::cerr << "reach_eval: " << message << "\n"
-            << "usage: reach_eval --targets N --seed S --set table|equilibria --executor model|mlp\n"
-               "                  [--weights FILE] [--load-kg M] [--model-error F] [--tol-pos M --tol-rot RAD]\n"
-               "                  [--damping analytical|analytical:NU|uniform:GAMMA] [--action elements|bspline[:K]|bspline-pinned[:K]]\n"
-               "                  [--max-node-speed V] --out FILE.csv\n";
+  std::cerr << "reach_eval: " << message << "\nRun with --help for more information.\n";
   std::exit(2);
 }
 
@@ -69,56 +70,57 @@ double parse_number(const std::string& flag, const std::string& text) {
   return v;
 }
 
-Options parse(int argc, char** argv) {
+/// The heaviest load the arm can hold: its weight at the arm's length takes the whole bend limit.
+double max_load_kg() {
+  const manisoft::env::ReachEnvConfig defaults;
+  return defaults.limits.bend / (9.81 * defaults.rod.length);
+}
+
+/// --damping analytical[:NU] or uniform[:GAMMA], the value finite and >= 0.
+void check_damping(const std::string& d) {
+  const auto colon = d.find(':');
+  const std::string kind = d.substr(0, colon);
+  if (kind != "analytical" && kind != "uniform") usage_error("--damping must be analytical[:NU] or uniform[:GAMMA], got '" + d + "'");
+  if (colon == std::string::npos) return;
+  const std::string value = d.substr(colon + 1);
+  if (parse_number("--damping", value) < 0) usage_error("--damping value must be >= 0 (got " + value + ")");
+}
+
+/// The options; `exit_code` is -1 to go on, else the code to exit with (0 after --help, 2 after
+/// a bad flag).
+Options parse(int argc, char** argv, int& exit_code) {
+  namespace cli = manisoft::cli;
   Options o;
-  bool have_out = false, have_seed = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error(flag + " needs a value");
-      return argv[++i];
-    };
-    if (flag == "--targets") {
-      const double v = parse_number(flag, value());
-      if (v < 1 || v != std::floor(v) || v > 1e7) usage_error("--targets must be a positive integer");
-      o.targets = static_cast<int>(v);
-    } else if (flag == "--seed") {
-      const double v = parse_number(flag, value());
-      if (v < 0 || v != std::floor(v) || v > 1e15) usage_error("--seed must be a non-negative integer");
-      o.seed = static_cast<long>(v);
-      have_seed = true;
-    } else if (flag == "--set") o.set = value();
-    else if (flag == "--executor") o.executor = value();
-    else if (flag == "--weights") o.weights = value();
-    else if (flag == "--load-kg") o.load = parse_number(flag, value());
-    else if (flag == "--model-error") o.model_error = parse_number(flag, value());
-    else if (flag == "--tol-pos") o.tol_pos = parse_number(flag, value());
-    else if (flag == "--tol-rot") o.tol_rot = parse_number(flag, value());
-    else if (flag == "--damping") o.damping = value();
-    else if (flag == "--action") o.action = value();
-    else if (flag == "--max-node-speed") {
-      o.max_node_speed = parse_number(flag, value());
-      if (o.max_node_speed <= 0) usage_error("--max-node-speed must be > 0 (m/s)");
-    } else if (flag == "--out") o.out = value(), have_out = true;
-    else usage_error("unknown option " + flag);
-  }
-  if (!have_out) usage_error("--out FILE.csv is required");
-  if (!have_seed) usage_error("--seed S is required");
-  if (o.set != "table" && o.set != "equilibria") usage_error("--set must be table or equilibria");
-  if (o.executor != "model" && o.executor != "mlp") usage_error("--executor must be model or mlp");
+  CLI::App app{"reach_eval: success rate of an executor on a seeded set of reach targets (CSV: one row per target). "
+               "Exit 0 done, 1 refused configuration or failed write, 2 bad flags."};
+  app.add_option("--targets", o.targets, "targets to run (default 100)")->check(cli::between(1, 1e7));
+  app.add_option("--seed", o.seed, "seed of the target set (target i: seed * 1000003 + i)")->required()->check(cli::between(0, 1e15));
+  app.add_option("--set", o.set, "table (default) or equilibria")->check(CLI::IsMember({"table", "equilibria"}));
+  app.add_option("--executor", o.executor, "model (default) or mlp")->check(CLI::IsMember({"model", "mlp"}));
+  app.add_option("--weights", o.weights, "MLP weight file (--executor mlp)");
+  const double max_load = max_load_kg();
+  char load_help[160];
+  std::snprintf(load_help, sizeof load_help, "held load unknown to the model, kg (at most %.3g: the bend limit over g times the arm's length)", max_load);
+  app.add_option("--load-kg", o.load, load_help)->check(cli::between(0, max_load));
+  app.add_option("--model-error", o.model_error, "F: the simulated Young's modulus is (1 + F) times the model's")->check(cli::above(-0.9));
+  app.add_option("--tol-pos", o.tol_pos, "position tolerance, m (default 0.03)")->check(cli::positive());
+  app.add_option("--tol-rot", o.tol_rot, "rotation tolerance, rad (default 0.3)")->check(cli::positive());
+  app.add_option("--damping", o.damping, "the simulated rod's damping: analytical[:NU] (default analytical:0.1) or uniform[:GAMMA]");
+  app.add_option("--action", o.action, "elements (default), bspline[:K] or bspline-pinned[:K]");
+  app.add_option("--max-node-speed", o.max_node_speed, "model executor: planned peak node speed of a smooth ramp, m/s")->check(cli::positive());
+  app.add_option("--out", o.out, "CSV file to write")->required();
+  cli::readable_errors(app, "reach_eval");
+  exit_code = cli::parse(app, argc, argv);
+  if (exit_code >= 0) return o;
   if (o.executor == "mlp" && o.weights.empty()) usage_error("--executor mlp needs --weights FILE");
-  if (o.load < 0) usage_error("--load-kg must be >= 0");
-  if (o.tol_pos <= 0 || o.tol_rot <= 0) usage_error("--tol-pos and --tol-rot must be > 0");
+  check_damping(o.damping);
   return o;
 }
 
 template <typename Env, typename Executor>
 int run(const Options& o, Executor& executor, Env& env) {
-  std::ofstream csv(o.out);
-  if (!csv) {
-    std::cerr << "reach_eval: cannot write " << o.out << "\n";
-    return 1;
-  }
+  manisoft::cli::OutputFile file(o.out);
+  std::ostream& csv = file.stream();
   csv << "index,target_x,target_y,target_z,target_rx,target_ry,target_rz,success,first_success_step,final_position_error,"
          "final_rotation_error,min_distance,stability_variance,diverged,target_draws,setup_us,setup_cpu_us,mean_step_us,clipped_fraction,"
          "max_node_speed,path_ratio\n";
@@ -172,6 +174,7 @@ int run(const Options& o, Executor& executor, Env& env) {
         << setup_us << ',' << setup_cpu_us << ',' << target_step_us / steps << ',' << double(clipped) / (double(info.step) * 3 * (env.n_elements() - 1))
         << ',' << max_speed << ',' << ratio << '\n';
   }
+  file.commit();  // before the summary: a run whose CSV failed reports no success rate
   std::printf("success: %.1f%% (%d of %d)\n", 100.0 * successes / o.targets, successes, o.targets);
   if (successes > 0) std::printf("mean control steps to success: %.1f\n", steps_sum / successes);
   else std::printf("mean control steps to success: n/a (no success)\n");
@@ -224,7 +227,9 @@ int run_with_action(const Options& o, Damping<double> damping) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Options o = parse(argc, argv);
+  int exit_code = -1;
+  const Options o = parse(argc, argv, exit_code);
+  if (exit_code >= 0) return exit_code;
   try {
     const std::string d = o.damping;
     const auto colon = d.find(':');

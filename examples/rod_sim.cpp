@@ -6,6 +6,10 @@
 //           [--damping none|analytical:NU|uniform:GAMMA] [--lab-torque T,UX,UY,UZ]
 //           [--follower-couple M1,M2,M3] [--direction X,Y,Z] [--normal X,Y,Z] [--float]
 //           [--allow-unstable] --out FILE.csv
+//
+// --help lists the flags. Bad flags exit 2 with a message naming the flag and the value; a run the
+// library refuses (a diverged rod, an unstable time step) or a failed write exits 1 and leaves no
+// CSV (the file is written under a temporary name and renamed when complete).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,7 +20,9 @@
 #include <string>
 #include <vector>
 
+#include "cli_checks.hpp"
 #include "manisoft/rod.hpp"
+#include "output_file.hpp"
 
 namespace {
 
@@ -33,12 +39,12 @@ struct Options {
   std::string out;
 };
 
+/// Most time steps a run may take (hours of computing at n = 20): a larger --t-end / --dt is a
+/// typing mistake, not a simulation.
+constexpr double max_steps = 1e8;
+
 [[noreturn]] void usage_error(const std::string& message) {
-  std::cerr << "rod_sim: " << message << "\n"
-            << "usage: rod_sim --n N --dt DT --t-end T --record-every R [--gravity]\n"
-               "               [--damping none|analytical:NU|uniform:GAMMA] [--lab-torque T,UX,UY,UZ]\n"
-               "               [--follower-couple M1,M2,M3] [--direction X,Y,Z] [--normal X,Y,Z]\n"
-               "               [--float] [--allow-unstable] --out FILE.csv\n";
+  std::cerr << "rod_sim: " << message << "\nRun with --help for more information.\n";
   std::exit(2);
 }
 
@@ -59,61 +65,72 @@ std::vector<double> parse_list(const std::string& flag, const std::string& text,
   return values;
 }
 
-Options parse(int argc, char** argv) {
-  Options o;
-  bool have_out = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error(flag + " needs a value");
-      return argv[++i];
-    };
-    if (flag == "--n") {
-      const double n = parse_number(flag, value());
-      if (n < 2 || n != std::floor(n) || n > 1e6) usage_error("--n must be an integer >= 2");
-      o.n = static_cast<int>(n);
-    } else if (flag == "--dt") o.dt = parse_number(flag, value());
-    else if (flag == "--t-end") o.t_end = parse_number(flag, value());
-    else if (flag == "--record-every") o.record_every = parse_number(flag, value());
-    else if (flag == "--gravity") o.gravity = true;
-    else if (flag == "--float") o.use_float = true;
-    else if (flag == "--allow-unstable") o.allow_unstable = true;
-    else if (flag == "--damping") {
-      const std::string d = value();
-      const auto colon = d.find(':');
-      o.damping = d.substr(0, colon);
-      if (o.damping == "none") {
-        if (colon != std::string::npos) usage_error("--damping none takes no value");
-      } else if (o.damping == "analytical" || o.damping == "uniform") {
-        if (colon == std::string::npos) usage_error("--damping " + o.damping + " needs a value, e.g. " + o.damping + ":0.1");
-        o.damping_value = parse_number(flag, d.substr(colon + 1));
-        if (o.damping_value < 0) usage_error("--damping value must be >= 0");
-      } else usage_error("--damping must be none, analytical:NU or uniform:GAMMA, got '" + d + "'");
-    } else if (flag == "--lab-torque") {
-      const auto v = parse_list(flag, value(), 4);
-      o.lab_torque = v[0];
-      o.lab_axis = Eigen::Vector3d(v[1], v[2], v[3]);
-    } else if (flag == "--follower-couple") {
-      const auto v = parse_list(flag, value(), 3);
-      o.follower = Eigen::Vector3d(v[0], v[1], v[2]);
-    } else if (flag == "--direction") {
-      const auto v = parse_list(flag, value(), 3);
-      o.direction = Eigen::Vector3d(v[0], v[1], v[2]);
-    } else if (flag == "--normal") {
-      const auto v = parse_list(flag, value(), 3);
-      o.normal = Eigen::Vector3d(v[0], v[1], v[2]);
-    } else if (flag == "--out") {
-      o.out = value();
-      have_out = true;
-    } else usage_error("unknown flag '" + flag + "'");
+Eigen::Vector3d vector3(const std::string& flag, const std::string& text) {
+  const auto v = parse_list(flag, text, 3);
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+void parse_damping(const std::string& d, Options& o) {
+  const auto colon = d.find(':');
+  o.damping = d.substr(0, colon);
+  if (o.damping == "none") {
+    if (colon != std::string::npos) usage_error("--damping none takes no value");
+  } else if (o.damping == "analytical" || o.damping == "uniform") {
+    if (colon == std::string::npos) usage_error("--damping " + o.damping + " needs a value, e.g. " + o.damping + ":0.1");
+    o.damping_value = parse_number("--damping", d.substr(colon + 1));
+    if (o.damping_value < 0) usage_error("--damping value must be >= 0 (got " + d.substr(colon + 1) + ")");
+  } else {
+    usage_error("--damping must be none, analytical:NU or uniform:GAMMA, got '" + d + "'");
   }
-  if (!have_out) usage_error("--out FILE.csv is required");
-  if (o.dt <= 0) usage_error("--dt must be > 0");
-  if (o.t_end < 0) usage_error("--t-end must be >= 0");
-  if (o.record_every <= 0) usage_error("--record-every must be > 0");
+}
+
+/// The checks that involve several flags (after CLI11 has checked each flag on its own).
+void check_timing(const Options& o) {
   const double ratio = o.record_every / o.dt;
-  if (std::abs(ratio - std::round(ratio)) > 1e-6 * ratio)
+  if (std::abs(ratio - std::round(ratio)) > 1e-6 * ratio || ratio < 0.5)
     usage_error("--record-every must be a whole number of time steps (record-every / dt = " + std::to_string(ratio) + ")");
+  if (o.t_end / o.dt > max_steps) {
+    char message[256];
+    std::snprintf(message, sizeof message, "--t-end %g s is %.3g steps of --dt %g s: at most %.0e steps (--t-end <= %g s at this --dt)", o.t_end,
+                  o.t_end / o.dt, o.dt, max_steps, max_steps * o.dt);
+    usage_error(message);
+  }
+}
+
+/// The options; `exit_code` is -1 to go on, else the code to exit with (0 after --help, 2 after
+/// a bad flag).
+Options parse(int argc, char** argv, int& exit_code) {
+  namespace cli = manisoft::cli;
+  Options o;
+  std::string damping = "none", lab_torque, follower, direction, normal;
+  CLI::App app{"rod_sim: a clamped Cosserat rod under gravity, torques and damping; writes the tip position and directors as CSV in "
+               "PyElastica's reference layout (t,tip_x,tip_y,tip_z,d1_x,...,d3_z). Exit 0 done, 1 refused by the library, 2 bad flags."};
+  app.add_option("--n", o.n, "elements (default 20)")->check(cli::between(2, 1e6));
+  app.add_option("--dt", o.dt, "time step, s (default 2e-4)")->check(cli::positive());
+  app.add_option("--t-end", o.t_end, "simulated time, s (default 2; at most 1e8 steps)")->check(cli::non_negative());
+  app.add_option("--record-every", o.record_every, "CSV row interval, s: a whole number of steps (default 0.01)")->check(cli::positive());
+  app.add_flag("--gravity", o.gravity, "gravity along -z");
+  app.add_option("--damping", damping, "none (default), analytical:NU or uniform:GAMMA (NU, GAMMA >= 0)");
+  app.add_option("--lab-torque", lab_torque, "T,UX,UY,UZ: torque T (N m) about the lab axis U on every element");
+  app.add_option("--follower-couple", follower, "M1,M2,M3: couple per unit length in the material frame");
+  app.add_option("--direction", direction, "X,Y,Z: the rod's initial direction (default 1,0,0)");
+  app.add_option("--normal", normal, "X,Y,Z: the rod's initial normal (default 0,0,1)");
+  app.add_flag("--float", o.use_float, "simulate in single precision");
+  app.add_flag("--allow-unstable", o.allow_unstable, "run a time step above the stability limit");
+  app.add_option("--out", o.out, "CSV file to write")->required();
+  cli::readable_errors(app, "rod_sim");
+  exit_code = cli::parse(app, argc, argv);
+  if (exit_code >= 0) return o;
+  parse_damping(damping, o);
+  if (!lab_torque.empty()) {
+    const auto v = parse_list("--lab-torque", lab_torque, 4);
+    o.lab_torque = v[0];
+    o.lab_axis = Eigen::Vector3d(v[1], v[2], v[3]);
+  }
+  if (!follower.empty()) o.follower = vector3("--follower-couple", follower);
+  if (!direction.empty()) o.direction = vector3("--direction", direction);
+  if (!normal.empty()) o.normal = vector3("--normal", normal);
+  check_timing(o);
   return o;
 }
 
@@ -140,11 +157,8 @@ int run(const Options& o, Damping<Scalar> damping) {
   for (int k = 0; k < o.n; ++k) couple.row(k) = (o.follower * (1.0 / o.n)).cast<Scalar>().transpose();
   rod.template forcing<manisoft::rod::forcing::ElementTorques>().set(couple);
 
-  std::ofstream out(o.out);
-  if (!out) {
-    std::cerr << "rod_sim: cannot open '" << o.out << "' for writing\n";
-    return 1;
-  }
+  manisoft::cli::OutputFile file(o.out);
+  std::ostream& out = file.stream();
   out << "t,tip_x,tip_y,tip_z,d1_x,d1_y,d1_z,d2_x,d2_y,d2_z,d3_x,d3_y,d3_z\n";
   char line[512];
   auto record = [&](long step) {
@@ -164,11 +178,12 @@ int run(const Options& o, Damping<Scalar> damping) {
     if (i % every == 0) record(i);
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  file.commit();  // before the summary: a run whose CSV failed reports no result
   const auto tip = rod.tip_position();
   std::fprintf(stderr, "rod_sim: n=%d %s t=%g s, %ld steps, final tip (%.9f, %.9f, %.9f) m, %.0f steps/s\n", o.n,
                std::is_same_v<Scalar, float> ? "float" : "double", double(steps) * o.dt, steps, double(tip[0]), double(tip[1]),
                double(tip[2]), seconds > 0 ? double(steps) / seconds : 0.0);
-  return out ? 0 : 1;
+  return 0;
 }
 
 template <typename Scalar>
@@ -181,7 +196,9 @@ int dispatch(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Options o = parse(argc, argv);
+  int exit_code = -1;
+  const Options o = parse(argc, argv, exit_code);
+  if (exit_code >= 0) return exit_code;
   try {
     return o.use_float ? dispatch<float>(o) : dispatch<double>(o);
   } catch (const manisoft::Error& e) {

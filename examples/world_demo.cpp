@@ -45,6 +45,7 @@
 #include "manisoft/rod/settle.hpp"
 #include "manisoft/world/arm_world.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
+#include "output_file.hpp"
 
 namespace {
 
@@ -287,8 +288,8 @@ int main(int argc, char** argv) {
     world::ArmWorld<Arm> world(Arm(arm, kDt, rod::damping::AnalyticalLinear<double>(0.5)), settings);
     const std::vector<rigid::BodyId> objects = world::populate_tabletop(world, target_xy);
     const auto specs = world::tabletop_objects(top, target_xy);
-    std::ofstream trace(out_path);
-    if (!trace) manisoft::detail::fail("cannot write the trace to '", out_path, "'");
+    manisoft::cli::OutputFile trace_file(out_path);  // renamed into place once complete
+    std::ostream& trace = trace_file.stream();
     trace.precision(7);
     trace << "step,time,S,finger_width,held,gripper_px,gripper_py,gripper_pz,gripper_qw,gripper_qx,gripper_qy,gripper_qz";
     const int n = world.rod().n_elements();
@@ -340,6 +341,7 @@ int main(int argc, char** argv) {
       std::printf("after %-8s t = %5.2f s: grasp centre (%.3f, %.3f, %.3f), S = %d, held = %s\n", ph.name, world.time(), g.x(), g.y(),
                   g.z(), ph.s, world.gripper().held() ? world.rigid().model(*world.gripper().held()).name.c_str() : "-");
     }
+    trace_file.commit();
     const Vec3 cube_end = world.rigid().position(objects[0]);
     std::printf("\ncube moved from (%.3f, %.3f, %.3f) to (%.3f, %.3f, %.3f); largest weld force %.2f N\n", cube_start.x(),
                 cube_start.y(), cube_start.z(), cube_end.x(), cube_end.y(), cube_end.z(), max_weld);

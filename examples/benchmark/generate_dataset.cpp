@@ -33,6 +33,7 @@
 #include <thread>
 #include <vector>
 
+#include "../cli_checks.hpp"
 #include "episode_images.hpp"
 #include "manisoft/dataset/dataset_index.hpp"
 #include "manisoft/dataset/expert_recording.hpp"
@@ -155,7 +156,9 @@ int main(int argc, char** argv) {
   app.add_option("--jobs", jobs, "worker threads")->check(CLI::Range(1, 256));
   app.add_option("--max-draws", plan.max_draws, "scene draws per episode before giving up")->check(CLI::Range(1, 100000));
   app.add_flag("--index-only", index_only, "only write the index (after every shard is done)");
-  CLI11_PARSE(app, argc, argv);
+  manisoft::cli::check_counts(app, {"--clean", "--randomized", "--seed"});
+  manisoft::cli::readable_errors(app, "generate_dataset");
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
     plan.tasks = parse_tasks(tasks);
     long shard_i = 0, shard_n = 1;

@@ -9,7 +9,8 @@
 //    "max_node_speed":..., "max_path_ratio":..., "failures":{"reason":count,...}}
 // (steps over all episodes, successful or not; speeds in m/s; path ratio: measured end-effector
 // path over the straight distance, worst segment of any episode). The CSV has one row per episode.
-// Exit codes: 0 done, 1 refused configuration or failed run, 2 bad flags (CLI11).
+// Exit codes: 0 done, 1 refused configuration or failed run (no CSV is left: it is written under a
+// temporary name and renamed when complete), 2 bad flags (CLI11).
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -20,6 +21,8 @@
 #include <map>
 #include <string>
 
+#include "../cli_checks.hpp"
+#include "../output_file.hpp"
 #include "manisoft/env/pick_place.hpp"
 
 int main(int argc, char** argv) {
@@ -28,15 +31,16 @@ int main(int argc, char** argv) {
   long seed = 1;
   double mass = 0.1;
   std::string object = "cube", out;
-  app.add_option("--episodes", episodes, "episodes to run")->required()->check(CLI::Range(1, 1000000));
-  app.add_option("--seed", seed, "seed of the task set (episode i: seed * 100000 + i)")->required()->check(CLI::Range(0L, 1000000000L));
-  app.add_option("--mass", mass, "object mass, kg (default 0.1)")->check(CLI::Range(0.001, 5.0));
+  app.add_option("--episodes", episodes, "episodes to run")->required()->check(manisoft::cli::between(1, 1e6));
+  app.add_option("--seed", seed, "seed of the task set (episode i: seed * 100000 + i)")->required()->check(manisoft::cli::between(0, 1e9));
+  app.add_option("--mass", mass, "object mass, kg (default 0.1)")->check(manisoft::cli::between(0.001, 5));
   app.add_option("--object", object, "cube (5 cm) or can (r 3.3 cm, lying on its side)")->check(CLI::IsMember({"cube", "can"}));
   app.add_option("--out", out, "per-episode CSV")->required();
-  CLI11_PARSE(app, argc, argv);
+  manisoft::cli::readable_errors(app, "pick_place_eval");
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
-    std::ofstream csv(out);
-    if (!csv) manisoft::detail::fail("pick_place_eval: cannot write '", out, "'");
+    manisoft::cli::OutputFile file(out);
+    std::ostream& csv = file.stream();
     csv << "episode,seed,success,failure,steps,cpu_s,executor_s,max_setup_s,max_node_speed,max_path_ratio,max_planned_ratio,"
            "place_error,tilt,grasp_step,release_step,object_x,object_y,object_yaw,place_x,place_y\n";
     csv.precision(9);
@@ -73,7 +77,7 @@ int main(int argc, char** argv) {
           << r.task.object.x() << ',' << r.task.object.y() << ',' << r.task.object_yaw << ',' << r.task.place.x() << ',' << r.task.place.y()
           << '\n';
     }
-    if (!csv.flush()) manisoft::detail::fail("pick_place_eval: writing '", out, "' failed");
+    file.commit();
     std::printf("executor: %.2f us per control step on average (CPU, path set-ups included), slowest path set-up %.3f ms\n",
                 1e6 * executor_s / double(std::max(1L, total_steps)), 1e3 * max_setup);
     std::printf("{\"episodes\":%d, \"success_rate\":%.4f, \"mean_steps\":%.1f, \"max_steps\":%d, \"mean_cpu_s\":%.4f, \"max_node_speed\":%.4f, "

@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "../cli_checks.hpp"
 #include "episode_images.hpp"
 #include "manisoft/dataset/dataset_index.hpp"
 #include "manisoft/scene/scene_json.hpp"
@@ -38,15 +39,16 @@ int main(int argc, char** argv) {
   double fov = 60.0;
   app.add_option("dir", dir, "dataset folder")->required()->check(CLI::ExistingDirectory);
   app.add_option("--out", out, "output folder")->required();
-  app.add_option("--every", every, "an image every K control steps")->check(CLI::PositiveNumber);
-  app.add_option("--image-size", size, "W H")->expected(2)->check(CLI::PositiveNumber);
-  app.add_option("--episodes", only, "only these episode indices (default: all)")->delimiter(',')->check(CLI::NonNegativeNumber);
+  app.add_option("--every", every, "an image every K control steps")->check(manisoft::cli::positive());
+  app.add_option("--image-size", size, "W H")->expected(2)->check(manisoft::cli::positive());
+  app.add_option("--episodes", only, "only these episode indices (default: all)")->delimiter(',')->check(manisoft::cli::non_negative());
   auto* p = app.add_option("--camera-position", position, "camera position X Y Z (m, world frame)")->expected(3);
   app.add_option("--look-at", look_at, "point at the image centre X Y Z (m)")->expected(3)->needs(p);
   app.add_option("--fov-y", fov, "vertical field of view, degrees")->needs(p);
   app.add_option("--renderer", renderer, "gl (in-process OpenGL, default) or blender")->check(CLI::IsMember({"gl", "blender"}));
   app.add_option("--engine", engine, "blender: workbench or cycles")->check(CLI::IsMember({"workbench", "cycles"}));
-  app.add_option("--samples", samples, "blender: Cycles samples")->check(CLI::Range(1, 4096));
+  app.add_option("--samples", samples, "blender: Cycles samples")->check(manisoft::cli::between(1, 4096));
+  manisoft::cli::readable_errors(app, "render_dataset");
   CLI11_PARSE(app, argc, argv);
   try {
     std::optional<ms::render::Camera> camera;

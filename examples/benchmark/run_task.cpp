@@ -22,6 +22,7 @@
 #include <string>
 #include <string_view>
 
+#include "../cli_checks.hpp"
 #include "manisoft/scene/scene_json.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/task/expert.hpp"
@@ -45,42 +46,44 @@ int main(int argc, char** argv) {
   app.add_option("--save-scene", save_scene, "write the episode's scene JSON here");
   app.add_option("--trace", trace_file, "CSV file: one row per control step (world_demo's layout)");
   app.add_flag("--quiet", quiet, "print only the JSON line");
-  app.add_option("--path-speed", expert_config.path_peak_speed, "expert: peak end-effector speed of a path with the gripper empty, m/s")->check(CLI::PositiveNumber);
-  app.add_option("--node-speed", expert_config.max_node_speed, "expert: planned peak speed of any rod node with the gripper empty, m/s")->check(CLI::PositiveNumber);
-  app.add_option("--carry-speed", expert_config.carry_peak_speed, "expert: peak end-effector speed while holding, m/s")->check(CLI::PositiveNumber);
-  app.add_option("--carry-grip-share", expert_config.carry_grip_share, "expert: a held line accelerates the object at most this share of max_hold_force / mass (0: not bounded)")->check(CLI::NonNegativeNumber);
-  app.add_option("--carry-node-speed", expert_config.carry_node_speed, "expert: planned peak node speed while holding, m/s")->check(CLI::PositiveNumber);
-  app.add_option("--path-cruise", expert_config.path_cruise, "expert: fraction of a path at constant speed (0: quintic timing)")->check(CLI::Range(0.0, 0.95));
-  app.add_option("--settle-speed", expert_config.settle_speed, "expert: close / open once the arm's tip is slower, m/s")->check(CLI::PositiveNumber);
-  app.add_option("--start-error", expert_config.start_error, "expert: a chained path starts once the previous one is this near its end, m")->check(CLI::PositiveNumber);
-  app.add_option("--via-error", expert_config.via_error, "expert: the same at an intermediate point of a leg (arc or via point), m")->check(CLI::PositiveNumber);
-  app.add_option("--arm-clearance", expert_config.arm_clearance, "expert: the rod clear of objects and obstacles along planned lines, m")->check(CLI::NonNegativeNumber);
+  app.add_option("--path-speed", expert_config.path_peak_speed, "expert: peak end-effector speed of a path with the gripper empty, m/s")->check(manisoft::cli::positive());
+  app.add_option("--node-speed", expert_config.max_node_speed, "expert: planned peak speed of any rod node with the gripper empty, m/s")->check(manisoft::cli::positive());
+  app.add_option("--carry-speed", expert_config.carry_peak_speed, "expert: peak end-effector speed while holding, m/s")->check(manisoft::cli::positive());
+  app.add_option("--carry-grip-share", expert_config.carry_grip_share, "expert: a held line accelerates the object at most this share of max_hold_force / mass (0: not bounded)")->check(manisoft::cli::non_negative());
+  app.add_option("--carry-node-speed", expert_config.carry_node_speed, "expert: planned peak node speed while holding, m/s")->check(manisoft::cli::positive());
+  app.add_option("--path-cruise", expert_config.path_cruise, "expert: fraction of a path at constant speed (0: quintic timing)")->check(manisoft::cli::between(0, 0.95));
+  app.add_option("--settle-speed", expert_config.settle_speed, "expert: close / open once the arm's tip is slower, m/s")->check(manisoft::cli::positive());
+  app.add_option("--start-error", expert_config.start_error, "expert: a chained path starts once the previous one is this near its end, m")->check(manisoft::cli::positive());
+  app.add_option("--via-error", expert_config.via_error, "expert: the same at an intermediate point of a leg (arc or via point), m")->check(manisoft::cli::positive());
+  app.add_option("--arm-clearance", expert_config.arm_clearance, "expert: the rod clear of objects and obstacles along planned lines, m")->check(manisoft::cli::non_negative());
   bool no_arm_check = false;
   app.add_flag("--no-arm-check", no_arm_check, "expert: do not check planned lines against objects and obstacles");
-  app.add_option("--stack-finger-clearance", expert_config.stack_finger_clearance, "expert: STK: the fingertips above the item below's top when released, m")->check(CLI::NonNegativeNumber);
-  app.add_option("--place-clearance", expert_config.place_clearance, "expert: the object's bottom above its support when released, m")->check(CLI::NonNegativeNumber);
-  app.add_option("--approach-distance", expert_config.approach_distance, "expert: approach pose distance from the grasp, m")->check(CLI::PositiveNumber);
-  app.add_option("--settle-error", expert_config.settle_error, "expert: close / open once the end-effector is this near its pose, m")->check(CLI::PositiveNumber);
-  app.add_option("--release-lift", expert_config.release_lift, "expert: a tall object is held this far above where its support took it before the release, m")->check(CLI::NonNegativeNumber);
-  app.add_option("--contact-depth", expert_config.contact_depth, "expert: a tall object's lower line ends this far below its support, m")->check(CLI::NonNegativeNumber);
-  app.add_option("--retract-speed", expert_config.retract_peak_speed, "expert: peak end-effector speed of the retract after a release, m/s")->check(CLI::PositiveNumber);
-  app.add_option("--release-settle-speed", expert_config.release_settle_speed, "expert: a tall object is let go once the arm's tip is slower, m/s")->check(CLI::NonNegativeNumber);
-  app.add_option("--lower-speed", expert_config.lower_peak_speed, "expert: peak end-effector speed of the lower line, m/s")->check(CLI::PositiveNumber);
-  app.add_option("--carry-height", expert_config.carry_height, "expert: end-effector above the place pose before lowering, m")->check(CLI::NonNegativeNumber);
-  app.add_option("--slow-lower", expert_config.slow_lower, "expert: a lower line longer than twice this runs at the carry's speed until this far above its end, m (0: all slow)")->check(CLI::NonNegativeNumber);
-  app.add_option("--carry-settle-speed", expert_config.carry_settle_speed, "expert: lower only once the arm's tip is slower at the end of the carry, m/s (0: at once)")->check(CLI::NonNegativeNumber);
-  app.add_option("--lift-height", expert_config.lift_height, "expert: straight up from the grasp first on a via carry, m")->check(CLI::NonNegativeNumber);
-  app.add_option("--min-segment-steps", expert_config.min_segment_steps, "expert: shortest path, control steps")->check(CLI::PositiveNumber);
-  app.add_option("--max-retries", expert_config.max_retries, "expert: re-tries of a move whose grasp failed, each with another grasp")->check(CLI::NonNegativeNumber);
-  app.add_option("--grasp-error", expert_config.grasp_error, "expert: a descent that ends farther from its grasp pose backs off and re-tries, m")->check(CLI::PositiveNumber);
-  app.add_option("--via-raise", expert_config.via_raise, "expert: the high variants of a grasp raise their via points this much, m")->check(CLI::NonNegativeNumber);
+  app.add_option("--stack-finger-clearance", expert_config.stack_finger_clearance, "expert: STK: the fingertips above the item below's top when released, m")->check(manisoft::cli::non_negative());
+  app.add_option("--place-clearance", expert_config.place_clearance, "expert: the object's bottom above its support when released, m")->check(manisoft::cli::non_negative());
+  app.add_option("--approach-distance", expert_config.approach_distance, "expert: approach pose distance from the grasp, m")->check(manisoft::cli::positive());
+  app.add_option("--settle-error", expert_config.settle_error, "expert: close / open once the end-effector is this near its pose, m")->check(manisoft::cli::positive());
+  app.add_option("--release-lift", expert_config.release_lift, "expert: a tall object is held this far above where its support took it before the release, m")->check(manisoft::cli::non_negative());
+  app.add_option("--contact-depth", expert_config.contact_depth, "expert: a tall object's lower line ends this far below its support, m")->check(manisoft::cli::non_negative());
+  app.add_option("--retract-speed", expert_config.retract_peak_speed, "expert: peak end-effector speed of the retract after a release, m/s")->check(manisoft::cli::positive());
+  app.add_option("--release-settle-speed", expert_config.release_settle_speed, "expert: a tall object is let go once the arm's tip is slower, m/s")->check(manisoft::cli::non_negative());
+  app.add_option("--lower-speed", expert_config.lower_peak_speed, "expert: peak end-effector speed of the lower line, m/s")->check(manisoft::cli::positive());
+  app.add_option("--carry-height", expert_config.carry_height, "expert: end-effector above the place pose before lowering, m")->check(manisoft::cli::non_negative());
+  app.add_option("--slow-lower", expert_config.slow_lower, "expert: a lower line longer than twice this runs at the carry's speed until this far above its end, m (0: all slow)")->check(manisoft::cli::non_negative());
+  app.add_option("--carry-settle-speed", expert_config.carry_settle_speed, "expert: lower only once the arm's tip is slower at the end of the carry, m/s (0: at once)")->check(manisoft::cli::non_negative());
+  app.add_option("--lift-height", expert_config.lift_height, "expert: straight up from the grasp first on a via carry, m")->check(manisoft::cli::non_negative());
+  app.add_option("--min-segment-steps", expert_config.min_segment_steps, "expert: shortest path, control steps")->check(manisoft::cli::positive());
+  app.add_option("--max-retries", expert_config.max_retries, "expert: re-tries of a move whose grasp failed, each with another grasp")->check(manisoft::cli::non_negative());
+  app.add_option("--grasp-error", expert_config.grasp_error, "expert: a descent that ends farther from its grasp pose backs off and re-tries, m")->check(manisoft::cli::positive());
+  app.add_option("--via-raise", expert_config.via_raise, "expert: the high variants of a grasp raise their via points this much, m")->check(manisoft::cli::non_negative());
   app.add_flag("!--estimate-in-contact", expert_config.freeze_estimate_in_contact, "expert: keep the executor's stiffness estimate running while the tool may touch things (descend, close, lower, open)");
-  app.add_option("--tight-clearance", expert_config.tight_clearance, "expert: a grasp whose open fingers clear the object by less a side is descended to at --tight-speed, m (0: never)")->check(CLI::NonNegativeNumber);
-  app.add_option("--tight-speed", expert_config.tight_peak_speed, "expert: peak end-effector speed of the descent to a tight grasp, m/s")->check(CLI::PositiveNumber);
+  app.add_option("--tight-clearance", expert_config.tight_clearance, "expert: a grasp whose open fingers clear the object by less a side is descended to at --tight-speed, m (0: never)")->check(manisoft::cli::non_negative());
+  app.add_option("--tight-speed", expert_config.tight_peak_speed, "expert: peak end-effector speed of the descent to a tight grasp, m/s")->check(manisoft::cli::positive());
   task::TaskEnvConfig env_config;
-  app.add_option("--executor-damping", env_config.executor.damping_gain, "executor: node velocity feedback kd, 1/s")->check(CLI::NonNegativeNumber);
-  app.add_option("--executor-stiffness", env_config.executor.position_gain, "executor: node position feedback kp, 1/s^2")->check(CLI::NonNegativeNumber);
-  CLI11_PARSE(app, argc, argv);
+  app.add_option("--executor-damping", env_config.executor.damping_gain, "executor: node velocity feedback kd, 1/s")->check(manisoft::cli::non_negative());
+  app.add_option("--executor-stiffness", env_config.executor.position_gain, "executor: node position feedback kp, 1/s^2")->check(manisoft::cli::non_negative());
+  manisoft::cli::check_counts(app, {"--index", "--seed"});
+  manisoft::cli::readable_errors(app, "run_task");
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   expert_config.check_arm_clearance = !no_arm_check;
   try {
     const std::clock_t c0 = std::clock();

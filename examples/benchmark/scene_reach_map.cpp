@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "../cli_checks.hpp"
 #include "manisoft/scene/reach_map.hpp"
 
 namespace scene = manisoft::scene;
@@ -21,10 +22,11 @@ int main(int argc, char** argv) {
   std::vector<double> heights{0.08, 0.15, 0.22, 0.30};
   std::string out = "reach.pgm";
   int scale = 8;
-  app.add_option("--cell", cell, "grid cell size [m]")->check(CLI::Range(0.005, 0.2));
+  app.add_option("--cell", cell, "grid cell size [m]")->check(manisoft::cli::between(0.005, 0.2));
   app.add_option("--heights", heights, "gripper frame heights above the top [m]")->delimiter(',');
   app.add_option("--out", out, "PGM picture to write");
-  app.add_option("--scale", scale, "pixels per cell")->check(CLI::Range(1, 64));
+  app.add_option("--scale", scale, "pixels per cell")->check(manisoft::cli::between(1, 64));
+  manisoft::cli::readable_errors(app, "scene_reach_map");
   CLI11_PARSE(app, argc, argv);
   try {
     auto statics = scene::make_scene_statics();

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <string>
 
+#include "../cli_checks.hpp"
 #include "manisoft/scene/scene_json.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
 
@@ -22,12 +23,13 @@ int main(int argc, char** argv) {
   bool quiet = false;
   app.add_option("--task", task, "COLL, ALN, STK or ARR")->required()->check(CLI::IsMember(manisoft::scene::task_names()));
   app.add_option("--setting", setting, "clean or randomized")->required()->check(CLI::IsMember({"clean", "randomized"}));
-  app.add_option("--index", index, "scene index (>= 0)")->required();
-  app.add_option("--seed", seed, "dataset seed (>= 0)")->required();
+  app.add_option("--index", index, "scene index (>= 0)")->required()->check(manisoft::cli::non_negative());
+  app.add_option("--seed", seed, "dataset seed (>= 0)")->required()->check(manisoft::cli::non_negative());
   app.add_option("--split", split, "train (default) or eval: disjoint seed streams")->check(CLI::IsMember({"train", "eval"}));
   app.add_option("--out", out, "scene JSON file to write")->required();
   app.add_flag("--quiet", quiet, "print nothing on success");
-  CLI11_PARSE(app, argc, argv);
+  manisoft::cli::readable_errors(app, "scene_sample");
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
     scene::SampleRequest q;
     q.task = scene::parse_task(task);

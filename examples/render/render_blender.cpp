@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "../cli_checks.hpp"
 #include "blender_run.hpp"
 #include "manisoft/render/render_io.hpp"
 #include "manisoft/render/tabletop_render_scene.hpp"
@@ -23,11 +24,12 @@ int main(int argc, char** argv) {
   app.add_option("--trace", trace_path, "world_demo CSV trace (README.md, \"world_demo\")")->required();
   app.add_option("--out", out_dir, "output folder")->required();
   app.add_option("--engine", engine, "cycles or workbench")->check(CLI::IsMember({"workbench", "cycles"}));
-  app.add_option("--samples", samples, "Cycles samples (denoising is off)")->check(CLI::Range(1, 4096));
-  app.add_option("--every", every, "render every N-th trace row")->check(CLI::PositiveNumber);
+  app.add_option("--samples", samples, "Cycles samples (denoising is off)")->check(manisoft::cli::between(1, 4096));
+  app.add_option("--every", every, "render every N-th trace row")->check(manisoft::cli::positive());
   app.add_option("--first", first, "first trace row");
   app.add_option("--last", last, "last trace row (inclusive)");
   app.add_flag("--masks", masks, "also write object-id masks (mask_<k>.png, flat colours)");
+  manisoft::cli::readable_errors(app, "render_blender");
   CLI11_PARSE(app, argc, argv);
   try {
     const tabletop::TabletopScene scene = tabletop::make_tabletop_scene();

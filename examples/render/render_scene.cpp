@@ -2,7 +2,8 @@
 // of a trace (world_demo's for the built-in scene, run_task's for its scene), and
 // writes rgb.png, depth.png (16-bit, mm), mask.png (object ids) and camera.json into --out.
 // With --episode it renders every --every-th trace row into DIR/frames/, an image strip
-// (strip.png) and, when ffmpeg is installed, DIR/episode.mp4.
+// (strip.png) and, when ffmpeg is installed, DIR/episode.mp4. A trace recorded in another scene
+// (other objects) is refused; a run that fails leaves no output folder it created.
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -12,6 +13,8 @@
 #include <iostream>
 #include <string>
 
+#include "../cli_checks.hpp"
+#include "../output_file.hpp"
 #include "blender_run.hpp"
 #include "manisoft/render/gl_renderer.hpp"
 #include "manisoft/render/render_io.hpp"
@@ -92,18 +95,19 @@ int main(int argc, char** argv) {
   long frame_arg = 0;
   int msaa = 0, every = 50, egl_device = -1, samples = 16;
   bool no_shadows = false, episode = false;
-  app.add_option("--scene", scene_path, "scene JSON written by scene_sample (README \"Scenes\")");
+  app.add_option("--scene", scene_path, "scene JSON written by scene_sample (docs/scenes.md)");
   app.add_option("--trace", trace_path, "CSV trace: world_demo's (built-in scene) or run_task's (with its --scene)");
   app.add_option("--frame", frame_arg, "trace row to render (0 = initial state; -1 the last row, -2 the one before, ...)");
   app.add_option("--renderer", renderer, "gl (in-process OpenGL, default) or blender")->check(CLI::IsMember({"gl", "blender"}));
   app.add_option("--out", out_dir, "output folder")->required();
-  app.add_option("--msaa", msaa, "OpenGL multisampling: 0, 2, 4 or 8");
+  app.add_option("--msaa", msaa, "OpenGL multisampling: 0, 2, 4 or 8")->check(CLI::IsMember({0, 2, 4, 8}));
   app.add_flag("--no-shadows", no_shadows, "OpenGL: no shadow map");
   app.add_option("--egl-device", egl_device, "EGL device index (-1: Mesa surfaceless platform)");
   app.add_option("--engine", engine, "blender: workbench or cycles")->check(CLI::IsMember({"workbench", "cycles"}));
-  app.add_option("--samples", samples, "blender: Cycles samples");
+  app.add_option("--samples", samples, "blender: Cycles samples")->check(manisoft::cli::between(1, 4096));
   app.add_flag("--episode", episode, "render every --every-th trace row into DIR/frames, strip.png and episode.mp4 (ffmpeg)");
-  app.add_option("--every", every, "with --episode: frame stride")->check(CLI::PositiveNumber);
+  app.add_option("--every", every, "with --episode: frame stride")->check(manisoft::cli::positive());
+  manisoft::cli::readable_errors(app, "render_scene");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -120,13 +124,16 @@ int main(int argc, char** argv) {
       scene = tabletop::make_tabletop_scene();
     }
     io::Trace trace;
-    if (!trace_path.empty()) trace = io::read_trace(trace_path);
+    if (!trace_path.empty()) {
+      trace = io::read_trace(trace_path);
+      io::require_trace_matches(scene, trace, trace_path, scene_path.empty() ? "the built-in scene" : scene_path);
+    }
     const long row_count = static_cast<long>(trace.rows.size());
     if (!trace_path.empty() && (frame_arg >= row_count || frame_arg < -row_count))
       manisoft::detail::fail("--frame ", frame_arg, " is out of range: the trace has ", row_count, " rows (0..", row_count - 1, ", or -1..-", row_count, ")");
     const std::size_t frame_index = static_cast<std::size_t>(frame_arg < 0 ? row_count + frame_arg : frame_arg);
-    const fs::path out(out_dir);
-    fs::create_directories(out);
+    manisoft::cli::OutputFolder folder(out_dir);  // removed again if it is new and the run fails
+    const fs::path& out = folder.path();
 
     if (renderer == "blender") {
       std::vector<std::size_t> rows;
@@ -161,6 +168,7 @@ int main(int argc, char** argv) {
         io::write_text_atomically(out / "camera.json", io::camera_json(calib, object_bounds(scene.scene, frames[0])));
       }
       std::printf("blender (%s): %zu frame(s) in %.2f s -> %s\n", engine.c_str(), frames.size(), seconds, out.string().c_str());
+      folder.keep();
       return 0;
     }
 
@@ -176,9 +184,11 @@ int main(int argc, char** argv) {
       io::write_frame(out, image, object_bounds(scene.scene, frame));
       std::printf("%s: %d x %d -> %s (rgb.png, depth.png, mask.png, camera.json)\n", gl.device_name().c_str(), image.width, image.height,
                   out.string().c_str());
+      folder.keep();
       return 0;
     }
     render_episode(gl, scene, trace, every, out);
+    folder.keep();
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "render_scene: %s\n", e.what());

@@ -174,8 +174,25 @@ TEST_CASE("malformed scene files are refused naming the file and the field", "[s
   auto err = [&](const std::string& text) { return error_of([&] { parse_scene(text, "bad.json"); }); };
   REQUIRE_THAT(err("{\"format\": "), Catch::Contains("bad.json") && Catch::Contains("not valid JSON at byte"));
   REQUIRE_THAT(err(with("\"task\": \"COLL\"", "\"task\": \"CLEAN\"")), Catch::Contains("bad.json: task") && Catch::Contains("unknown value 'CLEAN'"));
-  REQUIRE_THAT(err(with("\"lighting\"", "\"lightning\"")), Catch::Contains("bad.json: lighting: missing field"));
-  REQUIRE_THAT(err(with("\"asset_id\"", "\"asset\"")), Catch::Contains("objects[0].asset_id: missing field"));
+  // a misspelled field is named as typed; a field left out is named as missing
+  REQUIRE_THAT(err(with("\"lighting\"", "\"lightning\"")), Catch::Contains("bad.json: lightning: unknown field"));
+  REQUIRE_THAT(err(with("\"asset_id\"", "\"asset\"")), Catch::Contains("bad.json: objects[0].asset: unknown field"));
+  auto without = [&](const char* object, const char* key) {
+    nlohmann::json j = nlohmann::json::parse(good);
+    (object[0] ? j[object] : j).erase(key);
+    return j.dump();
+  };
+  REQUIRE_THAT(err(without("", "lighting")), Catch::Contains("bad.json: lighting: missing field"));
+  REQUIRE_THAT(err(without("table", "half_y")), Catch::Contains("bad.json: table.half_y: missing field"));
+  // an optional field misspelled is not ignored either
+  REQUIRE_THAT(err(with("\"rolling_resistance\"", "\"rolling_resistence\"")),
+               Catch::Contains("bad.json: table.rolling_resistence: unknown field") && Catch::Contains("rolling_resistance"));
+  // a key given twice (nlohmann would keep the last value), at the top, in a nested object, in an array's element
+  REQUIRE_THAT(err(with("\"half_x\": 0.4", "\"half_x\": 0.4, \"half_x\": 0.5")), Catch::Contains("bad.json: table.half_x: duplicate key"));
+  REQUIRE_THAT(err(with("\"task\": \"COLL\"", "\"task\": \"COLL\", \"task\": \"STK\"")), Catch::Contains("bad.json: task: duplicate key"));
+  REQUIRE_THAT(err(with("\"asset_id\"", "\"asset_id\": \"x\", \"asset_id\"")), Catch::Contains("bad.json: objects[0].asset_id: duplicate key"));
+  // a number beyond the range of a double: an error naming the file, not nlohmann's exception
+  REQUIRE_THAT(err(with("\"half_x\": 0.4", "\"half_x\": 1e400")), Catch::Contains("bad.json: cannot be read") && Catch::Contains("1e400"));
   REQUIRE_THAT(err(with("\"half_x\": 0.4", "\"half_x\": \"wide\"")), Catch::Contains("table.half_x: expected a number"));
   REQUIRE_THAT(err(with("\"format\": \"manisoft.scene/1\"", "\"format\": \"other/2\"")), Catch::Contains("format: is 'other/2'"));
   REQUIRE_THAT(err(with("\"index\": 1", "\"index\": -1")), Catch::Contains("index: expected a non-negative integer"));

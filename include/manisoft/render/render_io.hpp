@@ -82,6 +82,27 @@ inline Trace read_trace(const std::filesystem::path& path) {
   return t;
 }
 
+/// Refuses a trace recorded in another scene: every object the trace poses (its <name>_px columns
+/// other than the gripper's) must be one of the scene's, and every object of a scene file
+/// (object0, object1, ...) must be posed by the trace.
+inline void require_trace_matches(const tabletop::TabletopScene& scene, const Trace& t, const std::string& trace_name, const std::string& scene_name) {
+  std::string scene_objects;
+  for (const auto& [name, instance] : scene.object_instance) scene_objects += (scene_objects.empty() ? "" : ", ") + name;
+  for (const std::string& column : t.columns) {
+    const auto suffix = column.rfind("_px");
+    if (suffix == std::string::npos || suffix + 3 != column.size()) continue;
+    const std::string name = column.substr(0, suffix);
+    if (name != "gripper" && scene.object_instance.count(name) == 0)
+      manisoft::detail::fail("trace ", trace_name, " poses '", name, "', which ", scene_name, " does not have (its objects: ", scene_objects,
+                             "): the trace was recorded in another scene");
+  }
+  for (const auto& [name, instance] : scene.object_instance) {
+    if (name.rfind("object", 0) == 0 && !t.has(name + "_px"))
+      manisoft::detail::fail("trace ", trace_name, " has no pose of '", name, "' of ", scene_name, " (no column ", name,
+                             "_px): the trace was recorded in another scene");
+  }
+}
+
 inline math::Pose<double> pose_from(const Trace& t, std::size_t row, const std::string& prefix) {
   Eigen::Quaterniond q(t.at(row, prefix + "_qw"), t.at(row, prefix + "_qx"), t.at(row, prefix + "_qy"), t.at(row, prefix + "_qz"));
   if (!(q.norm() > 1e-9)) manisoft::detail::fail("trace row ", row, ": quaternion of '", prefix, "' has zero norm");

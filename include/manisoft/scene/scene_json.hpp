@@ -3,19 +3,23 @@
 // manisoft::scene). Doubles are written in nlohmann's shortest round-trip form, so a written file
 // parses back bit-identical; rotations are stored as 3 x 3 matrices (rows) for that reason.
 // Reading refuses, naming the file and the field ("scene.json: objects[2].pose.position[1]"): a
-// syntax error (with the byte offset), a missing field, a value of the wrong type, a non-finite
-// number, an unknown enum name, and (load_scene) an inconsistent scene (require_consistent: unknown
-// asset id, index out of range, a rotation that is not one, another arm mount). Writing goes
-// through a temporary file renamed into place: never a half-written file. The schema, with an
-// example, is in docs/scenes.md.
+// syntax error (with the byte offset), a number beyond the range of a double, a key given twice in
+// one object, a field the format does not have (a misspelled name), a missing field, a value of
+// the wrong type, a non-finite number, an unknown enum name, and (load_scene) an inconsistent
+// scene (require_consistent: unknown asset id, index out of range, a rotation that is not one,
+// another arm mount). Writing goes through a temporary file renamed into place: never a
+// half-written file. The schema, with an example, is in docs/scenes.md.
 #pragma once
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -75,6 +79,16 @@ struct Reader {
     return *it;
   }
   static std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+  /// Refuses a field of `j` that is not in `known` (a misspelled name would otherwise be ignored).
+  void only(const Json& j, const std::string& path, std::initializer_list<const char*> known) const {
+    if (!j.is_object()) fail(path.empty() ? "(top level)" : path, "expected an object");
+    for (const auto& item : j.items()) {
+      if (std::find_if(known.begin(), known.end(), [&](const char* k) { return item.key() == k; }) != known.end()) continue;
+      std::string names;
+      for (const char* k : known) names += names.empty() ? k : std::string(", ") + k;
+      fail(join(path, item.key()), "unknown field (the fields here: " + names + ")");
+    }
+  }
   double num(const Json& j, const std::string& key, const std::string& path) const {
     const Json& v = at(j, key, path);
     if (!v.is_number()) fail(join(path, key), "expected a number");
@@ -125,6 +139,7 @@ struct Reader {
   math::Pose<double> pose(const Json& j, const std::string& key, const std::string& path) const {
     const Json& v = at(j, key, path);
     const std::string p = join(path, key);
+    only(v, p, {"position", "rotation"});
     math::Pose<double> out;
     out.translation = vec3(v, "position", p);
     const Json& r = array(v, "rotation", p);
@@ -163,6 +178,54 @@ struct Reader {
     }
     return out;
   }
+};
+
+/// Refuses a key given twice in one object (nlohmann keeps the last value silently): a parser
+/// callback that keeps the path of the value being read ("table", "objects[2].pose") and the keys
+/// seen in each open object.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(std::string where) : where_(std::move(where)) {}
+  bool operator()(int /*depth*/, nlohmann::json::parse_event_t event, Json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+      case Event::array_start:
+        count_element();
+        open_.push_back(Frame{event == Event::array_start, -1, {}, {}});
+        break;
+      case Event::object_end:
+      case Event::array_end: open_.pop_back(); break;
+      case Event::key: {
+        Frame& f = open_.back();
+        f.key = parsed.get<std::string>();
+        if (std::find(f.keys.begin(), f.keys.end(), f.key) != f.keys.end())
+          manisoft::detail::fail(where_, ": ", path(), ": duplicate key (an object names each field once)");
+        f.keys.push_back(f.key);
+        break;
+      }
+      case Event::value: count_element(); break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    long index;  // arrays: the element being read
+    std::vector<std::string> keys;
+    std::string key;  // objects: the key being read
+  };
+  void count_element() {
+    if (!open_.empty() && open_.back().array) ++open_.back().index;
+  }
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : open_) p += f.array ? "[" + std::to_string(f.index) + "]" : (p.empty() ? "" : ".") + f.key;
+    return p;
+  }
+  std::string where_;
+  std::vector<Frame> open_;
 };
 
 inline const std::array<std::pair<const char*, render::TextureKind>, 6> texture_names{{{"none", render::TextureKind::none},
@@ -261,6 +324,8 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
   using json_detail::Json;
   const json_detail::Reader rd{where};
   if (!j.is_object()) rd.fail("(top level)", "expected a JSON object");
+  rd.only(j, "", {"format", "task", "setting", "split", "index", "seed", "table", "arm_mount", "objects", "obstacles", "lighting", "cameras", "goal",
+                  "instruction", "instructions_seen", "instructions_unseen", "sampling"});
   const std::string fmt = rd.str(j, "format", "");
   if (fmt != scene_format) rd.fail("format", "is '" + fmt + "', expected '" + scene_format + "'");
   SceneSpec s;
@@ -270,6 +335,7 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
   s.index = rd.u64(j, "index", "");
   s.seed = rd.u64(j, "seed", "");
   const Json& t = rd.at(j, "table", "");
+  rd.only(t, "table", {"top_center", "half_x", "half_y", "thickness", "friction", "rolling_resistance", "texture", "color", "secondary_color", "texture_scale"});
   s.table.top_center = rd.vec3(t, "top_center", "table");
   s.table.half_x = rd.num(t, "half_x", "table");
   s.table.half_y = rd.num(t, "half_y", "table");
@@ -282,6 +348,7 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
   s.table.secondary_color = rd.vec3(t, "secondary_color", "table");
   s.table.texture_scale = rd.num(t, "texture_scale", "table");
   const Json& m = rd.at(j, "arm_mount", "");
+  rd.only(m, "arm_mount", {"base_position", "pitch"});
   s.arm_mount.base_position = rd.vec3(m, "base_position", "arm_mount");
   s.arm_mount.pitch = rd.num(m, "pitch", "arm_mount");
   auto read_list = [&](const char* key, std::vector<PlacedAsset>& out) {
@@ -289,9 +356,11 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
     for (std::size_t i = 0; i < v.size(); ++i) {
       const std::string p = std::string(key) + "[" + std::to_string(i) + "]";
       PlacedAsset a;
+      rd.only(v[i], p, {"asset_id", "pose", "appearance"});
       a.asset_id = rd.str(v[i], "asset_id", p);
       a.pose = rd.pose(v[i], "pose", p);
       const Json& ap = rd.at(v[i], "appearance", p);
+      rd.only(ap, p + ".appearance", {"override_color", "color", "color_name", "texture"});
       a.appearance.override_color = rd.boolean(ap, "override_color", p + ".appearance");
       a.appearance.color = rd.vec3(ap, "color", p + ".appearance");
       a.appearance.color_name = rd.str(ap, "color_name", p + ".appearance");
@@ -302,6 +371,7 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
   read_list("objects", s.objects);
   read_list("obstacles", s.obstacles);
   const Json& l = rd.at(j, "lighting", "");
+  rd.only(l, "lighting", {"intensity", "color", "direction", "ambient_intensity"});
   s.lighting.intensity = rd.num(l, "intensity", "lighting");
   s.lighting.color = rd.vec3(l, "color", "lighting");
   s.lighting.direction = rd.vec3(l, "direction", "lighting");
@@ -313,6 +383,7 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
   for (std::size_t i = 0; i < cams.size(); ++i) {
     const std::string p = "cameras[" + std::to_string(i) + "]";
     render::Camera c;
+    rd.only(cams[i], p, {"position", "look_at", "up", "fov_y_deg", "width", "height"});
     c.position = rd.vec3(cams[i], "position", p);
     c.look_at = rd.vec3(cams[i], "look_at", p);
     c.up = rd.vec3(cams[i], "up", p);
@@ -326,13 +397,16 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
   const Json& g = rd.at(j, "goal", "");
   switch (s.task) {
     case Task::coll:
+      rd.only(g, "goal", {"object", "container"});
       s.goal.object = rd.integer(g, "object", "goal");
       s.goal.container = rd.integer(g, "container", "goal");
       break;
     case Task::aln: {
+      rd.only(g, "goal", {"object", "goal_pose", "symmetry"});
       s.goal.object = rd.integer(g, "object", "goal");
       s.goal.goal_pose = rd.pose(g, "goal_pose", "goal");
       const Json& sy = rd.at(g, "symmetry", "goal");
+      rd.only(sy, "goal.symmetry", {"kind", "order"});
       s.goal.symmetry.kind = rd.name_of(sy, "kind", "goal.symmetry",
                                         std::array<std::pair<const char*, Symmetry::Kind>, 3>{{{"none", Symmetry::Kind::none},
                                                                                                {"axial", Symmetry::Kind::axial},
@@ -341,12 +415,17 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
       if (s.goal.symmetry.order < 1) rd.fail("goal.symmetry.order", "must be >= 1");
       break;
     }
-    case Task::stk: s.goal.items = rd.ints(g, "items", "goal"); break;
+    case Task::stk:
+      rd.only(g, "goal", {"items"});
+      s.goal.items = rd.ints(g, "items", "goal");
+      break;
     case Task::arr: {
+      rd.only(g, "goal", {"relations"});
       const Json& rels = rd.array(g, "relations", "goal");
       for (std::size_t i = 0; i < rels.size(); ++i) {
         const std::string p = "goal.relations[" + std::to_string(i) + "]";
         Relation r;
+        rd.only(rels[i], p, {"kind", "objects", "references", "spots"});
         r.kind = rd.name_of(rels[i], "kind", p, json_detail::relation_names);
         r.objects = rd.ints(rels[i], "objects", p);
         r.references = rd.ints(rels[i], "references", p);
@@ -364,6 +443,7 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
   s.instructions_seen = rd.strings(j, "instructions_seen", "");
   s.instructions_unseen = rd.strings(j, "instructions_unseen", "");
   const Json& sm = rd.at(j, "sampling", "");
+  rd.only(sm, "sampling", {"engine_seed", "redraws", "rejections"});
   s.sampling.engine_seed = rd.u64(sm, "engine_seed", "sampling");
   s.sampling.redraws = rd.integer(sm, "redraws", "sampling");
   s.sampling.rejections = rd.strings(sm, "rejections", "sampling");
@@ -374,9 +454,11 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
 inline SceneSpec parse_scene(const std::string& text, const std::string& where) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(text);
+    j = nlohmann::json::parse(text, json_detail::DuplicateKeyCheck(where));
   } catch (const nlohmann::json::parse_error& e) {
     manisoft::detail::fail(where, ": not valid JSON at byte ", e.byte, ": ", e.what());
+  } catch (const nlohmann::json::exception& e) {  // a number beyond the range of a double (1e400)
+    manisoft::detail::fail(where, ": cannot be read: ", e.what());
   }
   return from_json(j, where);
 }
@@ -392,9 +474,19 @@ inline SceneSpec load_scene(const std::string& path, const AssetLibrary& lib) {
   return s;
 }
 
-/// Writes a scene file atomically (a temporary file renamed into place).
+/// Writes a scene file atomically (a temporary file renamed into place; a device or a pipe, such
+/// as /dev/stdout, is written in place).
 inline void save_scene(const std::string& path, const SceneSpec& s) {
   const std::string text = to_json_string(s);  // refuses non-finite values before touching the disk
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    out.flush();
+    if (!out) manisoft::detail::fail("writing the scene file '", path, "' failed");
+    return;
+  }
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
