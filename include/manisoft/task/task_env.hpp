@@ -33,8 +33,8 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
-#include <variant>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "manisoft/control/arm_observation.hpp"
