@@ -69,17 +69,10 @@ inline CLI::Validator positive() { return above(0); }
 inline CLI::Validator non_negative() { return at_least(0); }
 
 /// The count and seed options `names` (unsigned integers, where a negative value would wrap
-/// around) refuse a negative value with "--index must be >= 0 (got -1)"; an option's CLI11
-/// NonNegativeNumber check, if it has one, gives this message instead of its own.
+/// around) refuse a negative value with "--index must be >= 0 (got -1)". Give them no CLI11
+/// NonNegativeNumber check of their own: its message would come first.
 inline void check_counts(CLI::App& app, std::initializer_list<const char*> names) {
-  for (const char* name : names) {
-    CLI::Option* option = app.get_option(name);
-    try {
-      *option->get_validator("NONNEGATIVE") = non_negative();
-    } catch (const CLI::OptionNotFound&) {
-      option->check(non_negative());
-    }
-  }
+  for (const char* name : names) app.get_option(name)->check(non_negative());
 }
 
 /// Error messages as "program: --flag must be > 0 (got 0)" (CLI11 writes "--flag: must be ..."),

@@ -145,14 +145,14 @@ int main(int argc, char** argv) {
   bool resume = false, index_only = false;
   std::vector<int> image_size{128, 128};
   app.add_option("--tasks", tasks, "comma-separated tasks (COLL, ALN, STK, ARR)");
-  app.add_option("--clean", plan.clean, "clean-scene episodes in all")->check(CLI::NonNegativeNumber);
-  app.add_option("--randomized", plan.randomized, "randomized-scene episodes in all")->check(CLI::NonNegativeNumber);
+  app.add_option("--clean", plan.clean, "clean-scene episodes in all");
+  app.add_option("--randomized", plan.randomized, "randomized-scene episodes in all");
   app.add_option("--seed", plan.seed, "dataset seed");
   app.add_option("--out", out, "dataset folder")->required();
   app.add_option("--shard", shard, "i/n: this process makes the episodes k with k mod n = i");
   app.add_flag("--resume", resume, "skip episodes whose files are complete");
   app.add_option("--images", images, "none, or every:K (a camera image every K control steps)");
-  app.add_option("--image-size", image_size, "W H of the images")->expected(2)->check(CLI::PositiveNumber);
+  app.add_option("--image-size", image_size, "W H of the images")->expected(2)->check(manisoft::cli::positive());
   app.add_option("--jobs", jobs, "worker threads")->check(CLI::Range(1, 256));
   app.add_option("--max-draws", plan.max_draws, "scene draws per episode before giving up")->check(CLI::Range(1, 100000));
   app.add_flag("--index-only", index_only, "only write the index (after every shard is done)");
