@@ -1,4 +1,4 @@
-// reach_eval: success rate of an executor on a seeded set of reach targets (issue 4 part 5).
+// reach_eval: success rate of an executor on a seeded set of reach targets.
 //
 //   reach_eval --targets 100 --seed S --set table|equilibria --executor model|mlp
 //              [--weights FILE] [--load-kg M] [--model-error F] [--tol-pos M --tol-rot RAD]

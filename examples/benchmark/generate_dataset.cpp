@@ -1,4 +1,4 @@
-// generate_dataset: the expert dataset (issue 15; paper section 3.5) as robomimic-layout HDF5 files
+// generate_dataset: the expert dataset (paper section 3.5) as robomimic-layout HDF5 files
 // (include/manisoft/dataset/: one file an episode under DIR/episodes/, the index DIR/dataset.hdf5).
 //
 //   generate_dataset --tasks COLL,ALN,STK,ARR --clean N --randomized M --seed S --out DIR

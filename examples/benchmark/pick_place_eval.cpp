@@ -1,5 +1,5 @@
 // pick_place_eval: the model executor as a trajectory tracker on a tabletop pick and place
-// (issue 10; the routine is env::PickPlaceRunner, include/manisoft/env/pick_place.hpp).
+// (the routine is env::PickPlaceRunner, include/manisoft/env/pick_place.hpp).
 //
 //   pick_place_eval --episodes N --seed S [--mass KG] [--object cube|can] --out FILE.csv
 //

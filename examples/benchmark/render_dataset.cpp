@@ -1,5 +1,5 @@
 // render_dataset: camera images for a dataset generated with states only ("physics first, images
-// later", issue 15). Each episode's actions replay exactly from its scene (TaskEnv is
+// later"). Each episode's actions replay exactly from its scene (TaskEnv is
 // deterministic), and an image is rendered every K control steps, at any resolution and camera:
 //
 //   render_dataset DIR --out OUT [--every K] [--image-size W H] [--episodes K,...]

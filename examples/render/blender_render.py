@@ -1,4 +1,4 @@
-# Blender side of the ManiSoft renderer adapter (issue 14, section 3; the paper rendered with
+# Blender side of the ManiSoft renderer adapter (the paper rendered with
 # Blender): renders a folder written by include/manisoft/render/blender_export.hpp (scene.json,
 # frames.json, meshes/*.obj, rod_<k>.obj) headless, one Blender process for the whole trajectory:
 #
