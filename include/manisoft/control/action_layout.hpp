@@ -4,7 +4,6 @@
 // the Python environments, dataset files and their replay.
 #pragma once
 
-#include <cmath>
 #include <string>
 
 namespace manisoft::control {

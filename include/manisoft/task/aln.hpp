@@ -47,11 +47,8 @@ struct Aln {
     return c;
   }
 
-  /// The object already at its goal pose.
-  static bool holds_at_start(const Snapshot& snapshot, const Goal& goal, const Tolerances& tol = {}) {
-    const Conditions c = evaluate(snapshot, goal, tol);
-    return c.holds("position") && c.holds("orientation");
-  }
+  /// The object already at its goal pose (read off the conditions at reset).
+  static bool holds_at_start(const Conditions& c) { return c.holds("position") && c.holds("orientation"); }
 
   static int target_object(const scene::SceneSpec& spec) { return spec.goal.object; }
 };

@@ -54,22 +54,26 @@ struct Arr {
   /// Does the relation hold between the objects' centres of mass (horizontal plane)?
   static bool relation_holds(const Snapshot& snapshot, const Relation& r, const Tolerances& tol = {}) {
     std::array<int, 4> who{};
-    const int n = named(r, who);
-    const int lo = geometry::relation_min_count(r.kind), hi = geometry::relation_max_count(r.kind);
-    if (n < lo || n > hi) ::manisoft::detail::fail("relation ", to_string(r.kind), " needs ", lo, lo == hi ? "" : " or 4", " objects, got ", n);
+    return holds(snapshot, r.kind, who, named(r, who), tol);
+  }
+  /// The same for the relation's objects `who[0 .. n - 1]` (named()).
+  static bool holds(const Snapshot& snapshot, geometry::RelationKind kind, const std::array<int, 4>& who, int n, const Tolerances& tol) {
+    const int lo = geometry::relation_min_count(kind), hi = geometry::relation_max_count(kind);
+    if (n < lo || n > hi) ::manisoft::detail::fail("relation ", to_string(kind), " needs ", lo, lo == hi ? "" : " or 4", " objects, got ", n);
     std::array<Eigen::Vector2d, 4> centres;
     for (int k = 0; k < n; ++k)
       centres[static_cast<std::size_t>(k)] = detail::object_at(snapshot, who[static_cast<std::size_t>(k)]).center_of_mass.head<2>();
-    return geometry::relation_holds(r.kind, std::span<const Eigen::Vector2d>(centres.data(), static_cast<std::size_t>(n)), tol.arr);
+    return geometry::relation_holds(kind, std::span<const Eigen::Vector2d>(centres.data(), static_cast<std::size_t>(n)), tol.arr);
   }
 
   static Conditions evaluate(const Snapshot& snapshot, std::span<const Relation> relations, const Tolerances& tol = {}) {
     if (relations.empty()) ::manisoft::detail::fail("an arrangement needs at least one relation");
     bool hold = true, free = true, rest = true;
     for (const Relation& r : relations) {
-      hold = relation_holds(snapshot, r, tol) && hold;
       std::array<int, 4> who{};
-      const std::span<const int> objects(who.data(), static_cast<std::size_t>(named(r, who)));
+      const int n = named(r, who);
+      hold = holds(snapshot, r.kind, who, n, tol) && hold;
+      const std::span<const int> objects(who.data(), static_cast<std::size_t>(n));
       free = free && released(snapshot, objects);
       rest = rest && all_at_rest(snapshot, objects, tol);
     }
@@ -83,10 +87,8 @@ struct Arr {
     return evaluate(snapshot, std::span<const Relation>(goal.relations), tol);
   }
 
-  /// Every relation holds already.
-  static bool holds_at_start(const Snapshot& snapshot, const Goal& goal, const Tolerances& tol = {}) {
-    return evaluate(snapshot, goal, tol).holds("relations");
-  }
+  /// Every relation holds already (read off the conditions at reset).
+  static bool holds_at_start(const Conditions& c) { return c.holds("relations"); }
 
   /// The object the episode is about: the first relation's placed object.
   static int target_object(const scene::SceneSpec& spec) {

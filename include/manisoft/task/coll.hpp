@@ -71,8 +71,8 @@ struct Coll {
   }
 
   /// The part of the goal that a scene can satisfy before any step (contacts are known only
-  /// after one): the object already inside the container.
-  static bool holds_at_start(const Snapshot& snapshot, const Goal& goal, const Tolerances& tol = {}) { return inside(snapshot, goal, tol); }
+  /// after one), read off the conditions at reset: the object already inside the container.
+  static bool holds_at_start(const Conditions& c) { return c.holds("inside"); }
 
   /// The object the episode is about (per-category tables): the one to collect.
   static int target_object(const scene::SceneSpec& spec) { return spec.goal.object; }

@@ -5,8 +5,8 @@
 //
 // A task type provides: `id` (scene::Task), `summary`, `condition_names`, a `Goal` prepared from
 // the scene by `goal(spec, library)` (which refuses an ill-formed goal), `evaluate(snapshot,
-// goal, tolerances)` returning the named conditions (success: all hold), `holds_at_start`
-// (the goal already met before any step: the scene is no task), `target_object(spec)` and
+// goal, tolerances)` returning the named conditions (success: all hold), `holds_at_start(conditions)`
+// (the goal already met before any step, read off the conditions at reset: the scene is no task), `target_object(spec)` and
 // `tables_by_category` (whether evaluation groups its episodes by the target's category).
 #pragma once
 
@@ -34,7 +34,7 @@ concept TaskType = requires(const scene::SceneSpec& spec, const scene::AssetLibr
   { T::summary } -> std::convertible_to<std::string_view>;
   { T::goal(spec, library) } -> std::same_as<typename T::Goal>;
   { T::evaluate(snapshot, goal, tol) } -> std::same_as<Conditions>;
-  { T::holds_at_start(snapshot, goal, tol) } -> std::same_as<bool>;
+  { T::holds_at_start(T::evaluate(snapshot, goal, tol)) } -> std::same_as<bool>;
   { T::target_object(spec) } -> std::same_as<int>;
   { T::tables_by_category } -> std::convertible_to<bool>;
 };
@@ -63,8 +63,8 @@ struct TaskInfo {
 };
 
 inline TaskInfo task_info(scene::Task task) {
-  return visit_task(task, [task]<TaskType T>(T) {
-    return TaskInfo{task, scene::to_string(task), T::summary, std::vector<std::string_view>(T::condition_names.begin(), T::condition_names.end()),
+  return visit_task(task, []<TaskType T>(T) {
+    return TaskInfo{T::id, scene::to_string(T::id), T::summary, std::vector<std::string_view>(T::condition_names.begin(), T::condition_names.end()),
                     T::tables_by_category};
   });
 }

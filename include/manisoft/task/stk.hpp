@@ -60,11 +60,8 @@ struct Stk {
   }
   static Conditions evaluate(const Snapshot& snapshot, const Goal& goal, const Tolerances& tol = {}) { return evaluate(snapshot, std::span<const int>(goal.items), tol); }
 
-  /// The items already stacked, as far as positions tell.
-  static bool holds_at_start(const Snapshot& snapshot, const Goal& goal, const Tolerances& tol = {}) {
-    const Conditions c = evaluate(snapshot, goal, tol);
-    return c.holds("above_below") && c.holds("centred_on_below");
-  }
+  /// The items already stacked, as far as positions tell (read off the conditions at reset).
+  static bool holds_at_start(const Conditions& c) { return c.holds("above_below") && c.holds("centred_on_below"); }
 
   /// The first item the stack moves: the top one (the bottom item stays where it is).
   static int target_object(const scene::SceneSpec& spec) { return spec.goal.items.empty() ? -1 : spec.goal.items.back(); }

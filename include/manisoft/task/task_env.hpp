@@ -153,7 +153,7 @@ class TaskEnv {
     update_states();
     predicate();
     // A goal that holds before any action is no task: the scene is invalid (the episode ends).
-    const bool met = std::visit([this](const auto& g) { return task_of<decltype(g)>::holds_at_start(snapshot(), g, config_.tolerances); }, goal_);
+    const bool met = std::visit([this](const auto& g) { return task_of<decltype(g)>::holds_at_start(conditions_); }, goal_);
     if (met) finish(FailureReason::scene_invalid);
   }
 
