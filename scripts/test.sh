@@ -12,6 +12,8 @@
 # Tests that instantiate the same templates share an executable built as one unity translation
 # unit (tests/CMakeLists.txt): every test of the world, the executor, the assets, the scenes, the
 # tasks and the recorded expert is one unit, so the world is compiled once, not once per group.
+# For the same reason the programs the tests run are one executable (MANISOFT_ONE_PROGRAM_BINARY:
+# build/*/examples/manisoft_programs, each program's name a link to it).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 jobs=${JOBS:-2}
@@ -19,13 +21,13 @@ bash "$root/scripts/install_deps.sh"
 
 echo "== g++ Release build"
 cmake -S "$root" -B "$root/build/gcc-release" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" \
-  -DCMAKE_CXX_COMPILER=g++ -DMANISOFT_HEADER_CHECK=OFF -DMANISOFT_CHECK_ONLY=ON
+  -DCMAKE_CXX_COMPILER=g++ -DMANISOFT_HEADER_CHECK=OFF -DMANISOFT_CHECK_ONLY=ON -DMANISOFT_ONE_PROGRAM_BINARY=ON
 cmake --build "$root/build/gcc-release" -j"$jobs"
 (cd "$root/build/gcc-release" && ctest --output-on-failure -j"$jobs")
 
 echo "== clang++ ASan+UBSan build"
 cmake -S "$root" -B "$root/build/clang-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DMANISOFT_SANITIZE=ON -DMANISOFT_BUILD_EXAMPLES=ON -DMANISOFT_BUILD_BENCHMARKS=OFF -DMANISOFT_HEADER_CHECK=ON -DMANISOFT_CHECK_ONLY=ON
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DMANISOFT_SANITIZE=ON -DMANISOFT_BUILD_EXAMPLES=ON -DMANISOFT_BUILD_BENCHMARKS=OFF -DMANISOFT_HEADER_CHECK=ON -DMANISOFT_CHECK_ONLY=ON -DMANISOFT_ONE_PROGRAM_BINARY=ON
 cmake --build "$root/build/clang-asan" -j"$jobs"
 # The five longest tests under the sanitizers (30-160 s each there, 25 times their g++ time: the
 # nested bowls' contact, the scene-validity samples of COLL, ARR and STK, the placement band) run

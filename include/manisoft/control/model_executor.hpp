@@ -87,6 +87,10 @@
 // Only the observation is used: target, node positions/velocities, the end-effector pose.
 // No heap allocation in act() after the first call for a target; the inverse statics set-up of a
 // new target runs inside that call.
+//
+// Length: the feed-forward, the feedback map, the stiffness estimate, the outer loop and the line
+// tracking act on one executor state every control step (longer than the project's usual 600 lines
+// for that reason).
 #pragma once
 
 #include <Eigen/Core>

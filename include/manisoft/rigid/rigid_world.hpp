@@ -14,6 +14,10 @@
 // fixed-size buffers; query_capsule allocates only on first use).
 // Rollback: step() records what it changes (begin_step) and puts it back (undo_step) when a
 // body's state turns non-finite; save() / restore() snapshot the whole world at any time.
+//
+// Length: the world runs the step's stages above in order and keeps the bodies' bookkeeping that
+// every stage reads (sleep, rollback, snapshots); the narrow phase, the manifolds and the solver
+// live in contact/ (longer than the project's usual 600 lines for that reason).
 #pragma once
 
 #include "manisoft/contact/contact_solver.hpp"

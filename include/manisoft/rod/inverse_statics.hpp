@@ -35,6 +35,9 @@
 // Model estimates (set_model_estimates): the feed-forward can assume a stiffness scale and a
 // payload other than the model's without re-solving the shape (used by the model executor).
 // No heap allocation after construction.
+//
+// Length: the shape family, its tip Jacobian, the feed-forward and the solver share the
+// discretisation above and form one solver (longer than the project's usual 600 lines for that reason).
 #pragma once
 
 #include <Eigen/Cholesky>
