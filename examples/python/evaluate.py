@@ -20,25 +20,34 @@ A chunk's first --chunk-steps actions are executed before the policy is asked ag
 Scenes: the evaluation split (never drawn by dataset generation), eval indices 0, 1, 2, ... of each
 task and setting, the first K of each target-object category (STK: K in all); horizon T = manisoft.HORIZON (1500).
 Episodes alternate seen and unseen instructions where the scene has them (randomized scenes).
-A policy that raises, returns a malformed action or is slower than --policy-timeout seconds fails
-the episode with that reason; the evaluation goes on.
+A policy that raises (SystemExit included) or returns a malformed action fails the episode with
+that reason; the evaluation goes on. A python: policy is called in a helper thread so that
+--policy-timeout holds while it runs: one that has not answered by then fails its episode
+(policy_timeout) and, as its call is still running, stops the evaluation (exit 1; --resume goes
+on with a fresh process). A ws:// server that does not answer in time fails the episode and is
+reconnected.
 
-Output in --out: episodes.csv (one row an episode), results.csv and results.md (ACC % with its 95%
-Wilson interval and #Steps, the mean length of successes, per task, category and setting; seen
-vs unseen instructions; failure reasons), summary.json. Exit 0 when every episode ran (whatever
-its outcome), 1 on an error, 2 on bad flags.
+Output in --out: episodes.jsonl (each episode appended as it finishes, with run.json, the
+arguments of the run), then episodes.csv (one row an episode), results.csv and results.md (ACC %
+with its 95% Wilson interval and #Steps, the mean length of successes, per task, category and
+setting; seen vs unseen instructions; failure reasons) and summary.json once every episode has
+run. An interrupted run (Ctrl-C: exit 130) keeps its finished episodes; --resume with the same
+arguments runs the others. Exit 0 when every episode ran (whatever its outcome), 1 on an error,
+2 on bad flags.
 """
 import argparse
 import asyncio
 import atexit
 import csv
-import concurrent.futures
 import importlib
+import importlib.util
 import json
 import math
 import multiprocessing
 import os
+import signal
 import sys
+import threading
 import time
 from collections import Counter, defaultdict
 
@@ -96,12 +105,39 @@ def plan_episodes(task, setting, per_category, seed, max_scan, sampler):
 # ---- policies
 
 class PolicyFailure(Exception):
-    """The policy failed an episode: reason is the machine-readable failure."""
+    """The policy failed an episode: reason is the machine-readable failure; hung: its call is
+    still running (the evaluation cannot go on with it)."""
 
-    def __init__(self, reason, detail):
+    def __init__(self, reason, detail, hung=False):
         super().__init__(f"{reason}: {detail}")
         self.reason = reason
         self.detail = detail
+        self.hung = hung
+
+
+class TimedPolicy:
+    """Calls a Python policy in a daemon thread and waits at most `timeout` seconds for it: a call
+    still running then is abandoned (PolicyFailure "policy_timeout", hung). Whatever the policy
+    raises, SystemExit and KeyboardInterrupt included, is raised in the caller."""
+
+    def __init__(self, function, timeout):
+        self.function, self.timeout = function, timeout
+
+    def __call__(self, obs):
+        box, done = {}, threading.Event()
+
+        def call():
+            try:
+                box["answer"] = self.function(obs)
+            except BaseException as e:  # handed to the caller, which fails the episode with it
+                box["error"] = e
+            done.set()
+        threading.Thread(target=call, name="policy", daemon=True).start()
+        if not done.wait(self.timeout):
+            raise PolicyFailure("policy_timeout", f"the policy did not answer within {self.timeout} s", hung=True)
+        if "error" in box:
+            raise box["error"]
+        return box["answer"]
 
 
 def pack_openpi(obj):
@@ -287,10 +323,12 @@ class Worker:
         if spec.startswith("replay:"):
             return ReplayPolicy(spec[len("replay:"):])
         if spec.startswith("python:"):
-            return load_python_policy(spec, self.args.python_path)
+            return TimedPolicy(load_python_policy(spec, self.args.python_path), self.args.policy_timeout)
         return WebsocketPolicy(spec, self.args.policy_timeout)
 
     def run(self, episode):
+        """One episode: its record (episodes.csv's fields and its plan number) and whether the
+        policy hung (its call still running: the evaluation must stop)."""
         task, setting, index, category, number = episode
         env = self.current = self.env(task, setting)
         if self.policy is None:
@@ -300,23 +338,24 @@ class Worker:
         t0 = time.perf_counter()
         obs, info = env.reset(seed=self.args.seed, options={"index": index, "split": "eval", "instruction": instruction,
                                                           "instruction_index": number // 2})
-        if hasattr(policy, "start"):
-            policy.start(task, setting, index)
         size = env.action_space["shape"][0]
-        actions, failure, detail = [], info["failure"], ""
-        chunk, used = None, 0
-        while not info["done"]:
+        actions, failure, detail, hung = [], info["failure"], "", False
+        chunk, used, started = None, 0, True
+        try:
+            if hasattr(policy, "start"):
+                policy.start(task, setting, index)
+        except PolicyFailure as e:  # replay: no recording of this episode
+            failure, detail, started = e.reason, e.detail, False
+        while started and not info["done"]:
             if chunk is None or used >= min(len(chunk), self.args.chunk_steps):
                 try:
-                    start = time.perf_counter()
-                    answer = policy(obs)
-                    if time.perf_counter() - start > self.args.policy_timeout:
-                        raise PolicyFailure("policy_timeout", f"the policy took {time.perf_counter() - start:.1f} s > {self.args.policy_timeout} s")
-                    chunk, used = as_chunk(answer, size), 0
+                    chunk, used = as_chunk(policy(obs), size), 0
                 except PolicyFailure as e:
-                    failure, detail = e.reason, e.detail
+                    failure, detail, hung = e.reason, e.detail, e.hung
                     break
-                except Exception as e:  # the policy's own error: the episode fails, the evaluation goes on
+                except KeyboardInterrupt:
+                    raise
+                except BaseException as e:  # the policy's own error (SystemExit too): the episode fails, the evaluation goes on
                     failure, detail = "policy_error", f"{type(e).__name__}: {e}"
                     break
             action = chunk[used]
@@ -330,11 +369,11 @@ class Worker:
             np.save(tmp, np.asarray(actions, dtype=np.float64).reshape(-1, size))
             os.replace(tmp, path)
         success = bool(info["success"]) and failure is None
-        return {"task": task, "setting": setting, "category": category, "index": index, "seed": self.args.seed,
-                "instruction_kind": info["instruction_kind"], "success": success, "success_at_end": bool(info["success_at_end"]),
-                "steps": int(info["steps"]), "failure": "" if success else (failure or "policy_error"), "detail": detail,
-                "wall_s": round(time.perf_counter() - t0, 3)}
-
+        record = {"task": task, "setting": setting, "category": category, "index": index, "seed": self.args.seed,
+                  "instruction_kind": info["instruction_kind"], "success": success, "success_at_end": bool(info["success_at_end"]),
+                  "steps": int(info["steps"]), "failure": "" if success else (failure or "policy_error"), "detail": detail,
+                  "wall_s": round(time.perf_counter() - t0, 3), "number": number}
+        return record, hung
 
     def close(self):
         if isinstance(self.policy, WebsocketPolicy):
@@ -346,8 +385,10 @@ class Worker:
 _worker = None
 
 
-def _worker_init(args):
+def _worker_init(args, in_pool=False):
     global _worker
+    if in_pool:  # Ctrl-C is the parent's to handle: it terminates the pool
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     _worker = Worker(args)
     atexit.register(_worker.close)
 
@@ -447,6 +488,7 @@ def parse_args(argv):
     p.add_argument("--python-path", action="append", default=[], help="extra directory to import python: policies from")
     p.add_argument("--max-scan", type=int, default=None, help="eval indices scanned per task and setting to fill the categories")
     p.add_argument("--indices", type=int, nargs="+", default=None, help="run these eval indices of each task and setting instead")
+    p.add_argument("--resume", action="store_true", help="go on with the run in --out (the same arguments): run the episodes it has not finished")
     args = p.parse_args(argv)
     try:
         check_spec(args.policy)
@@ -459,14 +501,97 @@ def parse_args(argv):
         p.error("--episodes-per-category must be >= 1")
     if not args.policy_timeout > 0:
         p.error("--policy-timeout must be > 0")
+    for name in ("indices", "max_scan"):
+        values = getattr(args, name)
+        for v in values if isinstance(values, list) else [values]:
+            if v is not None and v < 0:
+                p.error(f"--{name.replace('_', '-')} must be >= 0 (got {v})")
+    if args.policy.startswith("python:"):
+        module = args.policy.split(":")[1]
+        for path in [os.getcwd()] + list(args.python_path):
+            if path not in sys.path:
+                sys.path.insert(0, path)
+        try:
+            found = importlib.util.find_spec(module) is not None
+        except (ImportError, ValueError):
+            found = False
+        if not found:
+            p.error(f"--policy {args.policy}: no module named '{module}' in the working directory, --python-path or sys.path")
+    try:
+        os.makedirs(args.out, exist_ok=True)
+        with open(os.path.join(args.out, ".write_check"), "w"):
+            pass
+        os.remove(os.path.join(args.out, ".write_check"))
+    except OSError as e:
+        p.error(f"--out {args.out}: cannot write there ({e.strerror or e})")
     args.tasks = TASKS if args.task == "all" else (args.task,)
     args.settings = SETTINGS if args.setting == "all" else (args.setting,)
     return args
 
 
+# ---- the run's progress: run.json (its arguments) and episodes.jsonl (each finished episode)
+
+RUN_ARGUMENTS = ("policy", "seed", "tasks", "settings", "episodes_per_category", "indices", "max_scan", "chunk_steps",
+                 "policy_timeout", "image_size")
+
+
+def run_arguments(args):
+    """What defines a run's episodes and their outcomes (compared on --resume)."""
+    return {k: (list(v) if isinstance(v, (list, tuple)) else v) for k, v in ((k, getattr(args, k)) for k in RUN_ARGUMENTS)}
+
+
+def flag_error(message):
+    """A bad flag: one line on stderr, exit 2 (as argparse does)."""
+    print(f"evaluate.py: error: {message}", file=sys.stderr)
+    raise SystemExit(2)
+
+
+def finished_episodes(args, plan):
+    """The episodes of the run in --out already finished, by plan number: none for a new run. A
+    folder holding another run is refused (without --resume, or with other arguments)."""
+    run_path, progress_path = os.path.join(args.out, "run.json"), os.path.join(args.out, "episodes.jsonl")
+    if not os.path.exists(run_path):
+        if os.path.exists(progress_path):
+            flag_error(f"--out {args.out}: episodes.jsonl without run.json: not a run of evaluate.py; choose another folder")
+        write_text(run_path, json.dumps(run_arguments(args), indent=2) + "\n")
+        return {}
+    try:
+        with open(run_path) as f:
+            before = json.load(f)
+    except (OSError, ValueError) as e:
+        flag_error(f"{run_path}: unreadable ({e}); choose another --out")
+    if not args.resume:
+        flag_error(f"--out {args.out} holds a run already (run.json): pass --resume to go on with it, or choose another folder")
+    for key, value in run_arguments(args).items():
+        if before.get(key) != value:
+            flag_error(f"--resume: --{key.replace('_', '-')} differs from the run in {args.out} (it ran with {before.get(key)!r}, now {value!r})")
+    done = {}
+    if os.path.exists(progress_path):
+        with open(progress_path) as f:
+            lines = f.read().split("\n")
+        for number, line in enumerate(lines[:-1], 1):  # the text after the last newline: a line cut by a kill, run again
+            try:
+                record = json.loads(line)
+                task, setting, index = plan[record["number"]][:3]
+                if (record["task"], record["setting"], record["index"]) != (task, setting, index):
+                    raise ValueError(f"episode {record['number']} is {record['task']} {record['setting']} {record['index']} here, "
+                                     f"{task} {setting} {index} in the plan")
+            except (ValueError, KeyError, IndexError, TypeError) as e:
+                raise RuntimeError(f"{progress_path}:{number}: not an episode of this run ({e})") from None
+            done[record["number"]] = record
+    return done
+
+
+def append_episode(path, record):
+    """Appends one finished episode to episodes.jsonl, on disk before the next one starts."""
+    with open(path, "a") as f:
+        f.write(json.dumps(record) + "\n")
+        f.flush()
+        os.fsync(f.fileno())
+
+
 def main(argv=None):
     args = parse_args(sys.argv[1:] if argv is None else argv)
-    os.makedirs(args.out, exist_ok=True)
     if args.save_actions:
         os.makedirs(os.path.join(args.out, "actions"), exist_ok=True)
     t0 = time.perf_counter()
@@ -479,35 +604,59 @@ def main(argv=None):
                 plan += [(task, setting, i, target_category(sampler.sample(task, setting, i, args.seed, "eval"))) for i in args.indices]
             else:
                 plan += plan_episodes(task, setting, k, args.seed, args.max_scan or 60 * k, sampler)
-    episodes_in = [p + (n,) for n, p in enumerate(plan)]
-    print(f"{len(plan)} episodes ({', '.join(f'{t} {s}: {sum(1 for p in plan if p[:2] == (t, s))}' for t in args.tasks for s in args.settings)})",
-          flush=True)
-    results = []
-    if args.jobs == 1:
-        _worker_init(args)
-        run = map(_worker_run, episodes_in)
-    else:
-        pool = concurrent.futures.ProcessPoolExecutor(args.jobs, mp_context=multiprocessing.get_context("spawn"),
-                                                      initializer=_worker_init, initargs=(args,))
-        run = pool.map(_worker_run, episodes_in)
-    for r in run:
-        results.append(r)
-        done = len(results)
-        ok = sum(e["success"] for e in results)
-        print(f"[{done}/{len(plan)}] {r['task']} {r['setting']} {r['category']} index {r['index']}: "
-              f"{'success' if r['success'] else r['failure']} after {r['steps']} steps ({r['wall_s']:.1f} s); success so far {ok}/{done}",
-              flush=True)
-    if args.jobs > 1:
-        pool.shutdown()
-    else:
-        atexit.unregister(_worker.close)
-        _worker.close()
+    try:
+        done = finished_episodes(args, plan)
+    except RuntimeError as e:
+        print(f"evaluate.py: {e}", file=sys.stderr)
+        return 1
+    todo = [p + (n,) for n, p in enumerate(plan) if n not in done]
+    print(f"{len(plan)} episodes ({', '.join(f'{t} {s}: {sum(1 for p in plan if p[:2] == (t, s))}' for t in args.tasks for s in args.settings)})"
+          + (f"; {len(done)} finished before, {len(todo)} to run" if done else ""), flush=True)
+    stopped = run_episodes(args, todo, done, len(plan))
+    if stopped:
+        print(f"evaluate.py: {stopped}; the {len(done)} finished episodes are in {os.path.join(args.out, 'episodes.jsonl')}: "
+              "--resume with the same arguments runs the others", file=sys.stderr, flush=True)
+        return 130 if stopped == "interrupted" else 1
+    results = [{k: v for k, v in done[n].items() if k != "number"} for n in sorted(done)]
     rows = write_outputs(args.out, args, results, time.perf_counter() - t0)
     for r in rows:
         if r["category"] == "all":
             print(f"{r['task']:>4} {r['setting']:<10} ACC {r['acc']:5.1f}% [{r['acc_low']:.1f}, {r['acc_high']:.1f}] over {r['episodes']} episodes")
     print(f"tables: {os.path.join(args.out, 'results.md')}")
     return 0
+
+
+def run_episodes(args, todo, done, total):
+    """Runs `todo` (in worker processes with --jobs > 1), adding each finished episode to `done`
+    and to episodes.jsonl; returns why the run stopped early ("" when every episode ran)."""
+    progress = os.path.join(args.out, "episodes.jsonl")
+    pool = None
+    try:
+        if args.jobs == 1:
+            _worker_init(args)
+            results = map(_worker_run, todo)
+        else:
+            pool = multiprocessing.get_context("spawn").Pool(args.jobs, initializer=_worker_init, initargs=(args, True))
+            results = pool.imap_unordered(_worker_run, todo)
+        for record, hung in results:
+            append_episode(progress, record)
+            done[record["number"]] = record
+            ok = sum(e["success"] for e in done.values())
+            print(f"[{len(done)}/{total}] {record['task']} {record['setting']} {record['category']} index {record['index']}: "
+                  f"{'success' if record['success'] else record['failure']} after {record['steps']} steps ({record['wall_s']:.1f} s); "
+                  f"success so far {ok}/{len(done)}", flush=True)
+            if hung:
+                return f"the policy did not answer within --policy-timeout {args.policy_timeout} s and is still running: the evaluation stops"
+        return ""
+    except KeyboardInterrupt:
+        return "interrupted"
+    finally:
+        if pool is not None:
+            pool.terminate()
+            pool.join()
+        elif _worker is not None:
+            atexit.unregister(_worker.close)
+            _worker.close()
 
 
 if __name__ == "__main__":

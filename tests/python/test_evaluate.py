@@ -1,13 +1,17 @@
 """The evaluation harness (examples/python/evaluate.py) on tiny runs: the expert succeeding and
-replayed from its saved actions, Python policies that raise or answer malformed actions, action
-chunks, a policy server on a loopback port speaking openpi's websocket protocol, worker processes
-giving the serial result, and the Wilson interval against textbook values."""
+replayed from its saved actions, Python policies that raise, exit, hang or answer malformed actions,
+action chunks, a policy server on a loopback port speaking openpi's websocket protocol, worker
+processes giving the serial result, an interrupted run resumed to the uninterrupted result, bad
+flags, and the Wilson interval against textbook values."""
 import asyncio
 import csv
 import json
 import os
 import shutil
+import signal
 import socket
+import subprocess
+import sys
 import tempfile
 import threading
 import unittest
@@ -109,7 +113,8 @@ class EvaluateTest(unittest.TestCase):
 
     def test_failing_python_policies_fail_their_episodes_only(self):
         for name, reason, detail in [("raising", "policy_error", "RuntimeError: model checkpoint missing"),
-                                     ("wrong_shape", "bad_action", "shape (4, 7)")]:
+                                     ("wrong_shape", "bad_action", "shape (4, 7)"),
+                                     ("exiting", "policy_error", "SystemExit: 3")]:
             out = self.out(name)
             code = evaluate.main(["--task", "COLL", "--setting", "clean", "--policy", "python:eval_policies:" + name,
                                   "--indices", "0", "1", "--image-size", "32", "32", "--out", out])
@@ -174,10 +179,64 @@ class EvaluateTest(unittest.TestCase):
         self.assertEqual(results[0], results[1])
 
     def test_bad_flags_exit_2(self):
-        for argv in (["--policy", "python:nomodule"], ["--policy", "grpc://x"], ["--jobs", "0"], ["--chunk-steps", "0"]):
+        a_file = self.out("a_file")
+        open(a_file, "w").close()
+        for argv in (["--policy", "python:nomodule"], ["--policy", "grpc://x"], ["--jobs", "0"], ["--chunk-steps", "0"],
+                     ["--policy", "python:no_such_module:act"], ["--indices", "3", "-1"], ["--max-scan", "-1"],
+                     ["--out", os.path.join(a_file, "out")]):
             with self.assertRaises(SystemExit) as e:
-                evaluate.main(argv + ["--out", self.out("bad")])
+                evaluate.main(argv + ([] if "--out" in argv else ["--out", self.out("bad")]))
             self.assertEqual(e.exception.code, 2)
+
+    def test_a_hanging_policy_stops_the_run_and_resume_goes_on(self):
+        out = self.out("hang")
+        argv = ["--task", "COLL", "--setting", "clean", "--policy", "python:eval_policies:hanging", "--indices", "0", "1",
+                "--image-size", "32", "24", "--policy-timeout", "0.5", "--out", out]
+        self.assertEqual(evaluate.main(argv), 1)  # stopped after the first episode: the call still runs
+        self.assertFalse(os.path.exists(os.path.join(out, "results.md")))
+        self.assertEqual(evaluate.main(argv + ["--resume"]), 1)  # the second, in the same way
+        self.assertEqual(evaluate.main(argv + ["--resume"]), 0)  # nothing left: the tables
+        rows = episodes(out)
+        self.assertEqual([(r["index"], r["failure"], r["steps"]) for r in rows], [("0", "policy_timeout", "0"), ("1", "policy_timeout", "0")])
+
+    def test_replay_without_a_recording_fails_that_episode_only(self):
+        empty = self.out("no_recordings")
+        os.makedirs(os.path.join(empty, "actions"))
+        out = self.out("replay_missing")
+        self.assertEqual(evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", "replay:" + empty, "--indices", "0", "1",
+                                        "--out", out]), 0)
+        for r in episodes(out):
+            self.assertEqual((r["failure"], r["steps"]), ("policy_error", "0"))
+            self.assertIn("no recorded actions", r["detail"])
+
+    def test_an_interrupted_run_resumes_to_the_uninterrupted_result(self):
+        flags = ["--task", "ALN", "--setting", "clean", "--policy", "python:eval_policies:slow_zeros", "--chunk-steps", "8",
+                 "--indices", "0", "1", "2", "3", "--image-size", "16", "16", "--python-path", os.path.dirname(eval_policies.__file__)]
+        out = self.out("interrupted")
+        script = os.path.join(os.path.dirname(evaluate.__file__), "evaluate.py")
+        run = subprocess.Popen([sys.executable, script, *flags, "--out", out], stdout=subprocess.PIPE, text=True)
+        for line in run.stdout:
+            if line.startswith("[1/4]"):
+                run.send_signal(signal.SIGINT)
+                break
+        self.assertEqual(run.wait(60), 130)
+        run.stdout.close()
+        with open(os.path.join(out, "episodes.jsonl")) as f:
+            finished = len(f.readlines())
+        self.assertGreaterEqual(finished, 1)
+        self.assertLess(finished, 4)
+        self.assertFalse(os.path.exists(os.path.join(out, "episodes.csv")))
+        with self.assertRaises(SystemExit) as e:  # the folder holds a run: only --resume goes on with it
+            evaluate.main(flags + ["--out", out])
+        self.assertEqual(e.exception.code, 2)
+        with self.assertRaises(SystemExit) as e:  # with the same arguments
+            evaluate.main(flags + ["--out", out, "--resume", "--seed", "1"])
+        self.assertEqual(e.exception.code, 2)
+        self.assertEqual(evaluate.main(flags + ["--out", out, "--resume"]), 0)
+        whole = self.out("whole")
+        self.assertEqual(evaluate.main(flags + ["--out", whole]), 0)
+        strip = lambda rows: [{k: v for k, v in r.items() if k != "wall_s"} for r in rows]
+        self.assertEqual(strip(episodes(out)), strip(episodes(whole)))
 
 
 if __name__ == "__main__":
