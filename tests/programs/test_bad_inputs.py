@@ -2,12 +2,17 @@
 non-zero exit status and a message that names the flag and the value, the key and the file, or
 the file that could not be written, and leaves no output that looks complete.
 
-    test_bad_inputs.py BIN_DIR SCRATCH_DIR
+    test_bad_inputs.py BIN_DIR SCRATCH_DIR [--write-table]
 
 BIN_DIR holds the example programs. rod_sim, reach_eval, scene_sample and render_scene are
 required (the tests build them); run_task, generate_dataset and pick_place_eval are checked when
 they are there (builds that only check them for warnings do not make them). Every case is listed
 as it runs: program, input, exit status and the message's first line.
+
+docs/bad-inputs.md holds the table of these cases as they run (the scratch folder written DIR):
+every row of a program built here must be in it and every row of it that names such a program
+must come out of this run, so the table cannot go stale. --write-table rewrites it from this run
+(keeping the rows of programs not built here).
 """
 import json
 import os
@@ -17,7 +22,10 @@ import subprocess
 import sys
 
 BIN, SCRATCH = sys.argv[1], sys.argv[2]
+WRITE_TABLE = "--write-table" in sys.argv[3:]
+TABLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "docs", "bad-inputs.md")
 failures = []
+rows = []  # (program, input, exit status, message) of each refused case, as the table shows them
 
 
 def program(name, required=True):
@@ -48,6 +56,7 @@ def refused(prog, args, expected, absent=(), code=None):
     rc, out = run(prog, args)
     first = next((line for line in out.splitlines() if line.strip()), "")
     print(f"{os.path.basename(prog)} {' '.join(args)}\n    exit {rc}: {first}")
+    rows.append(table_row(os.path.basename(prog), args, rc, first))
     problems = []
     if rc == 0 or (code is not None and rc != code):
         problems.append(f"exit status {rc}, expected {code if code is not None else 'non-zero'}")
@@ -55,6 +64,47 @@ def refused(prog, args, expected, absent=(), code=None):
     problems += [f"{p} was left behind" for p in absent for p in (p, p + ".tmp") if os.path.exists(p)]
     if problems:
         failures.append(f"{os.path.basename(prog)} {' '.join(args)}: " + "; ".join(problems) + "\n" + out)
+
+
+def table_row(name, args, rc, message):
+    """One line of docs/bad-inputs.md: the scratch folder written DIR, '|' escaped, decimals cut
+    to 6 places (the last digits of a divergence may differ between compilers)."""
+    cell = lambda text: re.sub(r"(\d\.\d{6})\d+", r"\1", text.replace(SCRATCH, "DIR").replace("|", "\\|"))
+    return f"| `{name}` | `{cell(' '.join(args))}` | {rc} | {cell(message)} |"
+
+
+TABLE_HEAD = """# Bad inputs and what the programs say
+
+Each row is a bad input tried on a command-line program and the first line of what the program
+says, with its exit status (1: refused by the library or a file that cannot be written; 2: a bad
+flag). The test `bad_inputs` (`tests/programs/test_bad_inputs.py`) runs every row and fails when
+this table no longer matches what the programs print; `test_bad_inputs.py BIN_DIR SCRATCH
+--write-table` rewrites it. In every case nothing that looks like a complete output is left
+behind (checked by the same test). DIR stands for the test's scratch folder.
+
+| program | input | exit | message |
+|---|---|---|---|
+"""
+
+
+def check_table():
+    """The table against this run: see the module's docstring."""
+    built = {r.split("`")[1] for r in rows}
+    try:
+        documented = [line for line in open(TABLE).read().splitlines() if line.startswith("| `")]
+    except OSError:
+        documented = []
+    kept = [r for r in documented if r.split("`")[1] not in built]
+    if WRITE_TABLE:
+        with open(TABLE, "w") as f:
+            f.write(TABLE_HEAD + "\n".join(rows + kept) + "\n")
+        print(f"-- wrote {TABLE}: {len(rows)} rows from this run, {len(kept)} kept")
+        return
+    missing = [r for r in rows if r not in documented]
+    stale = [r for r in documented if r.split("`")[1] in built and r not in rows]
+    if missing or stale:
+        failures.append(f"{TABLE} does not match this run (rewrite it with --write-table):\n"
+                        + "".join(f"  not in the table: {r}\n" for r in missing) + "".join(f"  not printed any more: {r}\n" for r in stale))
 
 
 def accepted(prog, args):
@@ -182,6 +232,7 @@ def main():
     reach_eval_cases()
     aln, huge = scene_cases()
     optional_cases(aln, huge)
+    check_table()
     for f in failures:
         print("FAILED:", f)
     print(f"{len(failures)} failure(s)")
