@@ -1,4 +1,4 @@
-// Executor compute (issue 4): the model executor's per-control-step cost (feedback, ramp,
+// Executor compute: the model executor's per-control-step cost (feedback, ramp,
 // stiffness estimate and outer-loop re-solves amortized as they occur), the per-target set-up
 // (cold inverse statics from the start library) on both target sets, and its one-time
 // construction. The step benchmark runs on both action spaces (element torques; 8 B-spline
@@ -75,7 +75,7 @@ void BM_ModelExecutorSetup(benchmark::State& state) {
 }
 BENCHMARK(BM_ModelExecutorSetup)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->Iterations(300);
 
-/// Path set-up (track_line, issue 10): the pick-and-place paths of 50 tasks (pre-grasp, grasp,
+/// Path set-up (track_line): the pick-and-place paths of 50 tasks (pre-grasp, grasp,
 /// carry, place), each planned from the end of the one before, the first from the settled home
 /// shape, with the held cube's payload from the carry on, as env::PickPlaceRunner plans them. The
 /// knots' inverse statics (with actuator relief) and the continuity checks. Also reports the

@@ -1,4 +1,4 @@
-// Renderer speed (issue 14, section 2): one 514 x 514 frame of the built-in tabletop scene (table,
+// Renderer speed: one 514 x 514 frame of the built-in tabletop scene (table,
 // floor, mount, arm tube re-built and re-uploaded every frame, gripper, 8 objects, goal marker),
 // per variant: no shadows, shadows (1024^2 map, or 512^2), shadows + depth + id read back, 4x MSAA,
 // a spot light (perspective shadow map over its cone); and the set-up cost (EGL display + context +

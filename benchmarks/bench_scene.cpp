@@ -1,5 +1,5 @@
-// Scene sampling benchmark (issue 12: "sampling plus validation of one scene at most 50 ms on
-// average"): SceneSampler::sample for each task and setting, cycling through scene indices (one
+// Scene sampling benchmark (target: sampling plus validation of one scene at most 50 ms on
+// average): SceneSampler::sample for each task and setting, cycling through scene indices (one
 // iteration = one accepted scene with all its redraws and checks: consistency, inverse-statics
 // reachability of grasps and goals, interpenetration, 0.5 s of settling in the rigid world).
 // Also the parts: validation alone, the JSON round trip, the sampler's set-up (asset catalogue,

@@ -1,5 +1,5 @@
-// Expert episode benchmark (issue 13: "one expert episode, planning and simulation, no rendering,
-// at most 0.1 s of CPU on average"): TaskEnv::reset + the expert until the episode ends, for
+// Expert episode benchmark (target: one expert episode, planning and simulation, no rendering,
+// at most 0.1 s of CPU on average): TaskEnv::reset + the expert until the episode ends, for
 // each task in clean scenes, cycling through train indices 0-24 (seed 0; scenes sampled once,
 // outside the timing). One iteration = one whole episode, whatever its outcome (a timeout runs all
 // 1,500 control steps). Counters: success rate and mean control steps over the iterations.

@@ -1,4 +1,4 @@
-// World step benchmark (issue 3): the world_demo scene (tabletop_scene.hpp: table and floor, the
+// World step benchmark: the world_demo scene (tabletop_scene.hpp: table and floor, the
 // arm mounted behind the table, the parallel gripper, eight resting objects), one world step =
 // gripper pre-step, coupling, rod contact, rod step (n = 20), rigid step, at dt = 2e-4 s.
 //   world_step/touching      the arm bent down, pressing the gripper onto the table top (the

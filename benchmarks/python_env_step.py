@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Speed of the Python task environment (issue 16: "env.step without rendering at most 20% slower
-than the C++ step; with the OpenGL renderer at most 10 ms per step"). The expert's actions on COLL
+"""Speed of the Python task environment (targets: env.step without rendering at most 20% slower
+than the C++ step; with the OpenGL renderer at most 10 ms per step). The expert's actions on COLL
 clean train scene 3 are recorded once, then replayed through env.step: without rendering (compare
 with bench_task's control_step, the same steps in C++), and with the 514 x 514 camera image.
 Prints min and median over --repeats of the mean step time (wall and CPU of this process).

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The expert's success table (issue 13): run_task on train scenes FIRST..LAST of every task and
+# The expert's success table: run_task on train scenes FIRST..LAST of every task and
 # setting (seed 0), JOBS at a time, one JSON line an episode into OUT, then a summary by task and
 # setting: successes, mean steps of the successes, failure reasons; the successes' lengths; COLL's
 # and ARR's successes by the category of the object moved, ARR's by relation.

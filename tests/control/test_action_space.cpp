@@ -1,4 +1,4 @@
-// Action spaces (issue 4 part 3): element torques are clamped to the actuation limits and the
+// Action spaces: element torques are clamped to the actuation limits and the
 // clamped count is exact; the B-spline muscle action reproduces a cubic couple profile exactly
 // (not-a-knot splines are exact on cubics), carries its couple across every node, is undone by
 // its projection, and bends a weightless rod until B kappa equals the muscle couple at every node.

@@ -1,4 +1,4 @@
-// Executors (issue 4): the inverse statics shape is an exact equilibrium of the simulated rod,
+// Executors: the inverse statics shape is an exact equilibrium of the simulated rod,
 // the model executor reaches targets of the reach environment, the MLP policy reproduces
 // hand-computed outputs and refuses malformed weight files, and bad targets are refused.
 #include <catch2/catch.hpp>
@@ -49,7 +49,8 @@ manisoft::env::ReachInfo run_episode(Env& env, Executor& executor, std::uint64_t
   return manisoft::env::rollout(env, executor, seed).info;
 }
 
-/// Issue 10's transients of one reach episode: the fastest node at any substep and the
+/// The transients of one reach episode (the pick-and-place limits: nodes under 1.5 m/s, a tip path
+/// at most 1.5 x the straight distance): the fastest node at any substep and the
 /// end-effector's path up to the first step of the held window.
 struct Transients {
   manisoft::env::ReachInfo info;
@@ -213,12 +214,12 @@ TEST_CASE("the model executor reaches and holds table targets", "[executor][reac
   }
 }
 
-TEST_CASE("a smooth shape ramp: via shapes shorten a looping blend, node speeds and the tip path stay within issue 10's limits", "[executor][reach]") {
+TEST_CASE("a smooth shape ramp: via shapes shorten a looping blend, node speeds and the tip path stay within the transient limits", "[executor][reach]") {
   // reach_eval's table target 23 of seed 1. With g++ -O3 solve_cold finds an end shape whose
   // single blend from the straight arm loops (tip path 2.5 x the straight distance); clang -O1
   // draws and solves it differently (1.4 x): which branch is found depends on round-off. Via
   // shapes pulled onto the straight line never lengthen the ramp and shorten a loop; the
-  // node-speed bound and cruise timing keep every node under issue 10's 1.5 m/s
+  // node-speed bound and cruise timing keep every node under the 1.5 m/s limit
   // (reach_eval --max-node-speed sets the same).
   manisoft::env::ReachEnv<manisoft::rod::damping::AnalyticalLinear> env({}, manisoft::rod::damping::AnalyticalLinear<double>(0.1));
   const std::uint64_t seed = 1 * 1000003ull + 23;

@@ -1,4 +1,4 @@
-// reach_eval, run as a user scripts it (issue 4 part 5): an MLP policy file drives the arm through
+// reach_eval, run as a user scripts it: an MLP policy file drives the arm through
 // `--executor mlp --weights FILE` to the pose its outputs hold, the model executor reaches
 // targets through the B-spline action space, and bad flags or files are refused.
 #include <catch2/catch.hpp>
@@ -97,8 +97,8 @@ TEST_CASE("reach_eval drives the B-spline muscle action space", "[executor][reac
   CHECK(header.rfind("index,target_x", 0) == 0);
 }
 
-TEST_CASE("reach_eval with a node speed bound keeps the transients of equilibria targets within issue 10's limits", "[executor][reach_eval]") {
-  // Issue 10's transient check: no node faster than 1.5 m/s, a tip path at most 1.5 x the
+TEST_CASE("reach_eval with a node speed bound keeps equilibria targets within the transient limits", "[executor][reach_eval]") {
+  // The transient check: no node faster than 1.5 m/s, a tip path at most 1.5 x the
   // straight distance. The default ramp (250 steps at least) sweeps equilibria target 0 of seed
   // 1 (0.65 m away) at up to 3 m/s; bounded to a planned 1.25 m/s it takes longer and stays under 1.5.
   const std::string out = scratch + "/bounded.csv";

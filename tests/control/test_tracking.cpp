@@ -1,4 +1,4 @@
-// The model executor as a trajectory tracker (issue 10): shape continuity on the yaw-90 and
+// The model executor as a trajectory tracker: shape continuity on the yaw-90 and
 // yaw-180 tool-down cases, refusal of a path that cannot be held, a moving-target tracking error
 // bound, payload compensation, and the pick-and-place routine (success, step and speed bounds,
 // determinism).

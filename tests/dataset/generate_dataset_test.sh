@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# generate_dataset end to end (issue 15): a small dataset (ALN and ARR, 3 clean + 3 randomized
+# generate_dataset end to end: a small dataset (ALN and ARR, 3 clean + 3 randomized
 # episodes; a second one, COLL and STK, 2 + 2, is generated, verified and read too, so every task
 # and setting is covered) made as 1 shard and as 3 shards run by GNU parallel with --index-only as the merge
 # step must be identical file for file, bit for bit; a run killed mid-way and resumed must give the
