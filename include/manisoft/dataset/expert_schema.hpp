@@ -171,8 +171,8 @@ inline scene::SceneSpec check_expert_attributes(const std::filesystem::path& fil
   same("instruction", text("instruction"), spec.instruction);
   same("instructions_seen", text("instructions_seen"), nlohmann::json(spec.instructions_seen).dump());
   same("instructions_unseen", text("instructions_unseen"), nlohmann::json(spec.instructions_unseen).dump());
-  same("scene_index", std::to_string(number("scene_index")), std::to_string(static_cast<double>(spec.index)));
-  same("seed", std::to_string(number("seed")), std::to_string(static_cast<double>(spec.seed)));
+  for (const auto& [name, of_scene] : {std::pair<const char*, double>{"scene_index", static_cast<double>(spec.index)}, {"seed", static_cast<double>(spec.seed)}})
+    if (number(name) != of_scene) at.fail("", "attribute '", name, "' = ", number(name), " but the scene attribute says ", of_scene);
 
   const double success = number("success");
   if (success != 0.0 && success != 1.0) at.fail("", "attribute 'success' = ", success, ": must be 0 or 1");
