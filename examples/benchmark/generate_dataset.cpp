@@ -15,13 +15,17 @@
 // same dataset comes out as one shard or as n shards (--shard i/n takes k = i, i + n, ...), with
 // any --jobs: file for file, bit for bit.
 // Atomic and resumable: an episode is written under a temporary name and renamed when complete;
-// --resume skips complete episodes (a killed run loses only the episodes in flight). When every
+// --resume skips complete episodes (a killed run loses only the episodes in flight). Each episode
+// records the run's arguments (attribute generate_args, the index's env_args): a run whose
+// arguments differ from those recorded in DIR is refused before anything is written, naming each
+// differing flag with both values. When every
 // episode of the dataset is there, the index is written (--index-only: only that, the merge step
 // after a sharded run; it names the first missing episode). Progress on stderr: a bar on a
 // terminal, plain lines otherwise. Exit 0 on success, 1 on an error, 2 on bad flags.
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -108,6 +112,7 @@ class Worker {
       }
       if (env_.info().success) {
         ms::dataset::Episode e = recorder.finish(k, plan_.seed, a);
+        e.text[std::string(ms::dataset::generate_args_attribute)] = plan_.env_args();
         if (plan_.image_every > 0) e.images["agentview_image"] = images_.render(env_, spec, e, plan_.image_every);
         return e;
       }
@@ -125,6 +130,46 @@ class Worker {
   ms::task::Expert expert_;
   manisoft_examples::EpisodeImages images_;  // rendered while a kept episode's actions replay: failed draws cost physics only
 };
+
+/// The flag (or library setting) behind a key of the recorded generation arguments.
+std::string flag_of(const std::string& key) {
+  static const std::map<std::string, std::string> flags{{"tasks", "--tasks"}, {"clean", "--clean"}, {"randomized", "--randomized"},
+                                                        {"seed", "--seed"}, {"max_draws", "--max-draws"}, {"image_every", "--images (every:K)"},
+                                                        {"image_width", "--image-size (W)"}, {"image_height", "--image-size (H)"}};
+  const auto it = flags.find(key);
+  return it != flags.end() ? it->second : key + " (the library's TaskEnvConfig)";
+}
+
+/// Refuses to add to a dataset generated with other arguments than this run's: compares them with
+/// those recorded in every complete episode file and in the index (if any), naming each differing
+/// argument with both values. Runs before anything is written.
+void require_recorded_arguments(const fs::path& dir, const Plan& plan) {
+  const nlohmann::json asked = nlohmann::json::parse(plan.env_args()).at("env_kwargs");
+  const auto compare = [&](const std::string& where, const std::string& recorded_text) {
+    const nlohmann::json recorded = nlohmann::json::parse(recorded_text, nullptr, false);
+    if (!recorded.is_object() || !recorded.contains("env_kwargs"))
+      ms::detail::fail(where, ": its recorded generation arguments are not readable: cannot add to it safely; use another --out");
+    std::string differences;
+    for (const auto& [key, value] : asked.items()) {
+      const auto& kwargs = recorded["env_kwargs"];
+      const std::string was = kwargs.contains(key) ? kwargs[key].dump() : "(not recorded)";
+      if (was != value.dump()) differences += (differences.empty() ? "" : ", ") + flag_of(key) + " is " + value.dump() + " here, " + was + " there";
+    }
+    if (!differences.empty())
+      ms::detail::fail(where, " was generated with other arguments: ", differences, ". Run with the recorded arguments, or use another --out");
+  };
+  for (long k : ms::dataset::complete_episodes(dir)) {
+    const ms::dataset::h5::File f = ms::dataset::h5::File::open(ms::dataset::episode_file(dir, k).string());
+    const auto names = f.attribute_names(ms::dataset::demo_path(k));
+    if (std::find(names.begin(), names.end(), ms::dataset::generate_args_attribute) == names.end())
+      ms::detail::fail(f.name(), ": records no generation arguments (an older generate_dataset wrote it): cannot add to it safely; use another --out");
+    compare(f.name(), f.read_string_attribute(ms::dataset::demo_path(k), ms::dataset::generate_args_attribute));
+  }
+  if (fs::exists(ms::dataset::index_file(dir))) {
+    const ms::dataset::h5::File index = ms::dataset::h5::File::open(ms::dataset::index_file(dir).string());
+    compare(index.name(), index.read_string_attribute("/data", "env_args"));
+  }
+}
 
 std::vector<ms::scene::Task> parse_tasks(const std::string& list) {
   std::vector<ms::scene::Task> out;
@@ -172,6 +217,7 @@ int main(int argc, char** argv) {
     plan.image_height = image_size[1];
     if (plan.total() < 1) ms::detail::fail("--clean + --randomized must be at least 1");
     const fs::path dir = out;
+    require_recorded_arguments(dir, plan);
     fs::create_directories(ms::dataset::episode_folder(dir));
     if (!index_only) {
       std::vector<long> todo;

@@ -12,8 +12,10 @@
 //                                every fifth episode is validation
 //
 // `verify_dataset` opens every file, reads every episode through the index and checks shapes,
-// finiteness, the counts and that the masks cover every demo exactly once; it names the first bad
-// file and field.
+// finiteness, each episode's content digest (episode_digest.hpp), that an episode's recorded
+// generate_args equal the index's env_args, the counts and that the masks cover every demo exactly
+// once; it names the first bad file and field. (What an expert episode must hold beyond this is
+// checked by expert_schema.hpp.)
 #pragma once
 
 #include <algorithm>
@@ -33,6 +35,8 @@ inline std::filesystem::path episode_file(const std::filesystem::path& dir, long
   return episode_folder(dir) / ("demo_" + std::to_string(index) + ".hdf5");
 }
 inline std::filesystem::path index_file(const std::filesystem::path& dir) { return dir / "dataset.hdf5"; }
+/// The episode attribute holding the generator's arguments: the same JSON as the index's env_args.
+inline constexpr const char* generate_args_attribute = "generate_args";
 
 /// The complete episode files in DIR/episodes (partial files skipped), by index.
 inline std::vector<long> complete_episodes(const std::filesystem::path& dir) {
@@ -127,20 +131,44 @@ struct VerifyReport {
   long partial_files = 0;  ///< "*.partial" left by an interrupted generator (not an error)
 };
 
+/// Refuses an episode read from `file` whose digest attribute is missing or differs from its content.
+inline void check_digest(const std::filesystem::path& file, const Episode& e) {
+  if (e.digest.empty())
+    h5::fail_at(file.string(), demo_path(e.index), "missing attribute '", digest_attribute,
+                "' (the content digest; files written before digests existed cannot be checked: regenerate them)");
+  const std::string actual = episode_digest(e);
+  if (actual != e.digest)
+    h5::fail_at(file.string(), demo_path(e.index), "content digest mismatch: attribute ", digest_attribute, " = ", e.digest,
+                ", the content gives ", actual, " (a dataset or attribute was changed after writing)");
+}
+
 /// Checks the whole dataset; throws InvalidInput naming the first bad file and field.
-inline VerifyReport verify_dataset(const std::filesystem::path& dir) {
+/// `check_episode(file, episode)` runs on each episode once it is read, before its digest is
+/// checked (expert_schema.hpp's check_expert_episode: a broken rule is named as such).
+template <typename CheckEpisode>
+VerifyReport verify_dataset(const std::filesystem::path& dir, CheckEpisode&& check_episode) {
   VerifyReport report;
   const h5::File index = h5::File::open(index_file(dir).string());
   const std::vector<long> indices = complete_episodes(dir);
   const std::vector<std::string> linked = index.children("/data");
   std::set<std::string> demos(linked.begin(), linked.end());
+  const std::string env_args = index.read_string_attribute("/data", "env_args");
   for (long k : indices) {
     if (!demos.count("demo_" + std::to_string(k)))
       h5::fail_at(index.name(), "/data", "episode file ", episode_file(dir, k).string(), " is not in the index");
   }
   for (const std::string& demo : linked) {
-    const long k = std::stol(demo.substr(5));
+    const std::string number = demo.substr(std::min<std::size_t>(5, demo.size()));
+    if (!demo.starts_with("demo_") || number.empty() || number.size() > 12 || number.find_first_not_of("0123456789") != std::string::npos)
+      h5::fail_at(index.name(), "/data/" + demo, "is not named demo_<k>");
+    const long k = std::stol(number);
     const Episode e = read_episode(episode_file(dir, k), k);  // names the episode file and field
+    check_episode(episode_file(dir, k), e);
+    check_digest(episode_file(dir, k), e);
+    const auto args = e.text.find(generate_args_attribute);
+    if (args != e.text.end() && args->second != env_args)
+      h5::fail_at(episode_file(dir, k).string(), demo_path(k), "attribute ", generate_args_attribute, " = ", args->second,
+                  " differs from the index's env_args = ", env_args, " (episodes of another run)");
     ++report.episodes;
     report.steps += e.steps();
     std::vector<hsize_t> shape = index.shape(demo_path(k) + "/actions");  // the link resolves
@@ -149,7 +177,6 @@ inline VerifyReport verify_dataset(const std::filesystem::path& dir) {
   }
   const auto total = index.read_numeric_attribute<std::int64_t>("/data", "total");
   if (total != report.steps) h5::fail_at(index.name(), "/data", "total = ", total, " but the episodes have ", report.steps, " steps");
-  index.read_string_attribute("/data", "env_args");
   std::set<std::string> seen;
   for (const char* split : {"train", "valid"}) {
     const auto members = index.read_strings(std::string("/mask/") + split);
@@ -164,6 +191,10 @@ inline VerifyReport verify_dataset(const std::filesystem::path& dir) {
   for (const auto& entry : std::filesystem::directory_iterator(episode_folder(dir)))
     if (entry.path().string().ends_with(partial_suffix)) ++report.partial_files;
   return report;
+}
+
+inline VerifyReport verify_dataset(const std::filesystem::path& dir) {
+  return verify_dataset(dir, [](const std::filesystem::path&, const Episode&) {});
 }
 
 }  // namespace manisoft::dataset

@@ -41,6 +41,9 @@ struct Episode {
   std::map<std::string, ImageSequence> images;      ///< name -> frames
   std::map<std::string, std::string> text;          ///< task, setting, scene (JSON), instructions (JSON), ...
   std::map<std::string, double> numbers;            ///< success, seed, ...
+  /// The digest attribute read from a file (episode_digest.hpp); "" when the file has none.
+  /// write_episode ignores it and stores the digest of what it writes.
+  std::string digest;
 
   long steps() const { return static_cast<long>(actions.rows()); }
 };

@@ -1,8 +1,9 @@
 // Writing and reading one episode file of the expert dataset (HDF5, robomimic's layout):
 //
 //   /data/demo_<k>                 attributes: num_samples (robomimic), every Episode::text entry
-//                                  (task, setting, scene JSON, instructions JSON, ...) and every
-//                                  Episode::numbers entry (success, seed, ...)
+//                                  (task, setting, scene JSON, instructions JSON, ...), every
+//                                  Episode::numbers entry (success, seed, ...) and digest, the
+//                                  content digest of all of it (episode_digest.hpp)
 //   /data/demo_<k>/actions         float64 T x (3 n + 1): element torques row by row, then S
 //                                  (actions and states: byte shuffle + gzip, chunks of 256
 //                                  steps; about 3/4 of the raw size)
@@ -27,6 +28,7 @@
 #include <vector>
 
 #include "manisoft/dataset/episode.hpp"
+#include "manisoft/dataset/episode_digest.hpp"
 #include "manisoft/dataset/hdf5.hpp"
 
 namespace manisoft::dataset {
@@ -80,8 +82,11 @@ inline void write_episode(const std::filesystem::path& path, const Episode& epis
       }
     }
     file.write_attribute(demo, "num_samples", static_cast<std::int64_t>(t));
-    for (const auto& [name, value] : episode.text) file.write_attribute(demo, name, value);
-    for (const auto& [name, value] : episode.numbers) file.write_attribute(demo, name, value);
+    for (const auto& [name, value] : episode.text)
+      if (name != digest_attribute) file.write_attribute(demo, name, value);
+    for (const auto& [name, value] : episode.numbers)
+      if (name != digest_attribute) file.write_attribute(demo, name, value);
+    file.write_attribute(demo, digest_attribute, episode_digest(episode));
     file.close();
   } catch (...) {
     std::error_code ignored;
@@ -148,7 +153,8 @@ inline Episode read_episode(const std::filesystem::path& path, long index) {
   }
   for (const std::string& name : file.attribute_names(demo)) {
     if (name == "num_samples") continue;
-    if (file.attribute_is_string(demo, name)) e.text[name] = file.read_string_attribute(demo, name);
+    if (name == digest_attribute) e.digest = file.read_string_attribute(demo, name);
+    else if (file.attribute_is_string(demo, name)) e.text[name] = file.read_string_attribute(demo, name);
     else e.numbers[name] = file.read_numeric_attribute<double>(demo, name);
   }
   const auto samples = file.read_numeric_attribute<std::int64_t>(demo, "num_samples");

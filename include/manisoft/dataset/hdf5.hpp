@@ -175,6 +175,25 @@ class File {
     return dims_of(open_dataset(path), path);
   }
 
+  /// The stored element type of the dataset at `path`: "float64", "float32", "uint8", "int64",
+  /// "string", or a description of any other type ("integer of 2 bytes, signed").
+  std::string dtype(const std::string& path) const {
+    ScopedSilence silence;
+    const Handle data = open_dataset(path);
+    Handle stored(H5Dget_type(data.get()), H5Tclose);
+    const H5T_class_t kind = H5Tget_class(stored.get());
+    const std::size_t size = H5Tget_size(stored.get());
+    if (kind == H5T_FLOAT && (size == 8 || size == 4)) return size == 8 ? "float64" : "float32";
+    if (kind == H5T_STRING) return "string";
+    if (kind == H5T_INTEGER) {
+      const bool is_signed = H5Tget_sign(stored.get()) == H5T_SGN_2;
+      if (size == 1 && !is_signed) return "uint8";
+      if (size == 8 && is_signed) return "int64";
+      return "integer of " + std::to_string(size) + " bytes, " + (is_signed ? "signed" : "unsigned");
+    }
+    return "type class " + std::to_string(static_cast<int>(kind)) + " of " + std::to_string(size) + " bytes";
+  }
+
   /// Reads a whole dataset as T (converted by HDF5 from the stored type); `shape` gets its shape.
   template <typename T>
   std::vector<T> read(const std::string& path, std::vector<hsize_t>& shape) const {
