@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
     scene::SceneSpec spec;
     if (!scene_file.empty()) {
       spec = scene::load_scene(scene_file, sampler.library());
+      scene::require_valid(spec, sampler.validator(), scene_file);
     } else {
       scene::SampleRequest q;
       q.task = scene::parse_task(task_name);

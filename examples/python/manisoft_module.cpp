@@ -14,7 +14,10 @@
 // torques. Other real dtypes are converted; torques are clamped to the actuation limits
 // (action_space["low"/"high"]). Bad input (shape, dtype, NaN, a call after close) raises
 // ValueError / RuntimeError with the library's message; the GIL is released while the simulation
-// steps and while a frame renders.
+// steps and while a frame renders. Lists and tuples are accepted as actions (numpy.asarray). An
+// environment serves one call at a time from any thread, and once it renders only the thread that
+// first reset it (its EGL context is current there); other calls raise RuntimeError and change
+// nothing (task_environment.hpp, ThreadUse). close() and deletion work from any thread.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -54,13 +57,14 @@ class ReachEnvironment {
         next_seed_(seed),
         action_(Array3::Zero(env_.n_elements(), 3)) {}
 
-  py::tuple reset(std::optional<std::uint64_t> seed, const std::optional<py::dict>& options) {
+  py::tuple reset(const py::object& seed, const std::optional<py::dict>& options) {
+    const auto entered = threads_.enter("reset");
     check_open();
     if (options) {
       for (const auto& item : *options)
         throw py::value_error("reset: unknown option '" + py::str(item.first).cast<std::string>() + "' (the reach environment takes none)");
     }
-    const std::uint64_t s = seed ? *seed : next_seed_;
+    const std::uint64_t s = seed.is_none() ? next_seed_ : manisoft_py::count_arg(seed, "reset: seed");
     next_seed_ = s + 1;
     {
       py::gil_scoped_release release;
@@ -71,8 +75,10 @@ class ReachEnvironment {
     return py::make_tuple(observation(), info());
   }
 
-  py::tuple step(const py::array& action) {
+  py::tuple step(const py::handle& given) {
+    const auto entered = threads_.enter("step");
     check_started();
+    const py::array action = manisoft_py::action_array(given, "step: action");
     const char kind = action.dtype().kind();
     if (kind != 'f' && kind != 'i' && kind != 'u')
       throw py::value_error("step: action dtype must be real (float64 preferred), got " + py::str(action.dtype()).cast<std::string>());
@@ -99,6 +105,7 @@ class ReachEnvironment {
 
   /// The model-based expert's action for the current observation (float64 n x 3).
   py::array_t<double> expert_action() {
+    const auto entered = threads_.enter("expert_action");
     check_started();
     Array3 action(env_.n_elements(), 3);
     {
@@ -133,7 +140,10 @@ class ReachEnvironment {
     return d;
   }
 
-  void close() { closed_ = true; }
+  void close() {
+    const auto entered = threads_.enter("close", true);
+    closed_ = true;
+  }
   int horizon() const { return env_.config().horizon; }
 
  private:
@@ -184,6 +194,7 @@ class ReachEnvironment {
   const manisoft::control::Observation<double>* observation_ = nullptr;
   bool started_ = false;
   bool closed_ = false;
+  manisoft_py::ThreadUse threads_;
 };
 
 /// Renders any state of a scene: for replaying recorded states or a user's own.

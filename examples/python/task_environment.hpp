@@ -25,6 +25,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "manisoft/control/action_layout.hpp"
@@ -66,6 +67,73 @@ inline ms::math::Pose<double> pose_of(const py::handle& h, const std::string& wh
     throw py::value_error(what + ": its rotation block is not orthonormal");
   return p;
 }
+
+/// What a refused argument was: its repr and, unless an int or a float, its type ("'3' (str)").
+inline std::string describe(const py::handle& v) {
+  const std::string type = py::str(py::type::of(v).attr("__name__"));
+  return std::string(py::repr(v)) + (type == "int" || type == "float" ? "" : " (" + type + ")");
+}
+
+/// A count or seed argument: a Python int (not a bool) in [0, 2^64), else ValueError naming it.
+inline std::uint64_t count_arg(const py::handle& v, const std::string& what) {
+  if (py::isinstance<py::int_>(v) && !py::isinstance<py::bool_>(v)) {
+    const unsigned long long x = PyLong_AsUnsignedLongLong(v.ptr());
+    if (!(x == static_cast<unsigned long long>(-1) && PyErr_Occurred())) return x;
+    PyErr_Clear();  // negative or 2^64 and above
+  }
+  throw py::value_error(what + " must be an integer in [0, 2^64), got " + describe(v));
+}
+
+/// A string argument, else ValueError naming it.
+inline std::string string_arg(const py::handle& v, const std::string& what) {
+  if (!py::isinstance<py::str>(v)) throw py::value_error(what + " must be a string, got " + describe(v));
+  return py::str(v);
+}
+
+/// An action as a numpy array: an array as it is, a list or tuple through numpy.asarray; else
+/// ValueError naming `what`.
+inline py::array action_array(const py::handle& action, const std::string& what) {
+  if (py::isinstance<py::array>(action)) return py::reinterpret_borrow<py::array>(action);
+  try {
+    return py::module_::import("numpy").attr("asarray")(action);
+  } catch (const py::error_already_set& e) {
+    throw py::value_error(what + " must be an array of numbers, got " + describe(action) + ": " + e.what());
+  }
+}
+
+/// Which threads may call an environment: any one at a time (a second thread's call while the
+/// first runs without the GIL raises), and once it renders only the thread whose EGL context it
+/// draws with. Every entry point calls enter() first, so a refused call changes nothing.
+class ThreadUse {
+ public:
+  class Entered {
+   public:
+    explicit Entered(bool& busy) : busy_(busy) { busy_ = true; }
+    Entered(const Entered&) = delete;
+    Entered& operator=(const Entered&) = delete;
+    ~Entered() { busy_ = false; }
+
+   private:
+    bool& busy_;
+  };
+
+  /// Checked under the GIL (no other Python thread runs meanwhile).
+  [[nodiscard]] Entered enter(const char* call, bool any_thread = false) {
+    if (busy_) throw std::runtime_error(std::string(call) + ": the environment is in use by another thread (one call at a time)");
+    if (!any_thread && bound_ && *bound_ != std::this_thread::get_id())
+      throw std::runtime_error(std::string(call) + ": this environment renders with an EGL context bound to the thread that first "
+                               "reset it; call it from that thread (or make one environment per thread)");
+    return Entered(busy_);
+  }
+  /// From now on only the calling thread may use it (its renderer's context is current here).
+  void bind() {
+    if (!bound_) bound_ = std::this_thread::get_id();
+  }
+
+ private:
+  bool busy_ = false;
+  std::optional<std::thread::id> bound_;
+};
 
 /// A camera from a dict (keys position, look_at, up, fov_y_deg, width, height; others refused),
 /// starting from `base`.
@@ -154,11 +222,11 @@ class TaskEnvironment {
   /// options: "index" (scene index; default: the next one), "split" ("train" | "eval"),
   /// "instruction" ("canonical" | "seen" | "unseen"), "instruction_index" (which of them, modulo
   /// their number), "scene" (a scene JSON string instead of sampling).
-  py::tuple reset(std::optional<std::uint64_t> seed, const std::optional<py::dict>& options) {
+  py::tuple reset(const py::object& seed, const std::optional<py::dict>& options) {
+    const auto entered = threads_.enter("reset");
     check_open();
-    if (seed) seed_ = *seed;
     ms::scene::SampleRequest q = request_;
-    q.seed = seed_;
+    q.seed = seed.is_none() ? seed_ : count_arg(seed, "reset: seed");
     q.index = next_index_;
     std::string instruction_kind = "canonical";
     std::size_t instruction_index = 0;
@@ -166,11 +234,12 @@ class TaskEnvironment {
     if (options) {
       for (const auto& [k, v] : *options) {
         const std::string key = py::str(k);
-        if (key == "index") q.index = v.cast<std::uint64_t>();
-        else if (key == "split") q.split = ms::scene::parse_split(v.cast<std::string>());
-        else if (key == "instruction") instruction_kind = v.cast<std::string>();
-        else if (key == "instruction_index") instruction_index = v.cast<std::size_t>();
-        else if (key == "scene") scene_json = v.cast<std::string>();
+        const std::string what = "reset: options['" + key + "']";
+        if (key == "index") q.index = count_arg(v, what);
+        else if (key == "split") q.split = ms::scene::parse_split(string_arg(v, what));
+        else if (key == "instruction") instruction_kind = string_arg(v, what);
+        else if (key == "instruction_index") instruction_index = count_arg(v, what);
+        else if (key == "scene") scene_json = string_arg(v, what);
         else throw py::value_error("reset: unknown option '" + key + "' (index, split, instruction, instruction_index, scene)");
       }
     }
@@ -178,20 +247,23 @@ class TaskEnvironment {
       throw py::value_error("reset: option 'instruction' = '" + instruction_kind + "' must be 'canonical', 'seen' or 'unseen'");
     {
       py::gil_scoped_release release;
-      if (scene_json) {
-        spec_ = ms::scene::parse_scene(*scene_json, "reset(options['scene'])");
-        ms::scene::require_consistent(spec_, sampler_.library(), "reset(options['scene'])");
+      if (scene_json) {  // checked as a sampled scene is, before anything changes
+        ms::scene::SceneSpec given = ms::scene::parse_scene(*scene_json, "reset(options['scene'])");
+        ms::scene::require_valid(given, sampler_.validator(), "reset(options['scene'])");
+        spec_ = std::move(given);
       } else {
         spec_ = sampler_.sample(q);
       }
       env_.reset(spec_);
       expert_.reset();
     }
+    seed_ = q.seed;
     next_index_ = q.index + 1;
     const auto& list = instruction_kind == "seen" ? spec_.instructions_seen : instruction_kind == "unseen" ? spec_.instructions_unseen : std::vector<std::string>{};
     instruction_ = list.empty() ? spec_.instruction : list[instruction_index % list.size()];
     instruction_kind_ = list.empty() ? "canonical" : instruction_kind;
     if (render_) {
+      threads_.bind();
       if (!gl_) gl_ = make_policy_renderer();
       renderer_.emplace(spec_, sampler_.library(), camera_ ? camera_ : std::optional<ms::render::Camera>(spec_.cameras.front()), *gl_);
     }
@@ -199,7 +271,8 @@ class TaskEnvironment {
     return py::make_tuple(observation(), info());
   }
 
-  py::tuple step(const py::array& action) {
+  py::tuple step(const py::handle& action) {
+    const auto entered = threads_.enter("step");
     check_started();
     if (env_.done()) throw std::runtime_error("step: the episode is over (" + std::to_string(env_.info().step) + " steps); call reset()");
     int s = read_action(action, torques_);
@@ -213,6 +286,7 @@ class TaskEnvironment {
 
   /// The expert's action for the current state (privileged: it reads the world).
   py::array_t<double> expert_action() {
+    const auto entered = threads_.enter("expert_action");
     check_started();
     int s = 0;
     {
@@ -226,6 +300,7 @@ class TaskEnvironment {
 
   /// The current frame from the environment's camera (any time after reset; needs render=True).
   py::array_t<std::uint8_t> render() {
+    const auto entered = threads_.enter("render");
     check_started();
     if (!renderer_) throw std::runtime_error("render: make the environment with render=True");
     update_frame();
@@ -271,7 +346,9 @@ class TaskEnvironment {
     return d;
   }
 
+  /// From any thread (the renderer's objects are left to its context when it is current elsewhere).
   void close() {
+    const auto entered = threads_.enter("close", true);
     renderer_.reset();
     gl_.reset();
     closed_ = true;
@@ -294,7 +371,8 @@ class TaskEnvironment {
   }
 
   /// Reads a flat action into `torques`; returns S. Refuses before anything changes.
-  int read_action(const py::array& action, Array3& torques) const {
+  int read_action(const py::handle& given, Array3& torques) const {
+    const py::array action = action_array(given, "step: action");
     const char kind = action.dtype().kind();
     if (kind != 'f' && kind != 'i' && kind != 'u')
       throw py::value_error("step: action dtype must be real (float64 preferred), got " + std::string(py::str(action.dtype())));
@@ -396,6 +474,7 @@ class TaskEnvironment {
   Array3 torques_;
   bool started_ = false;
   bool closed_ = false;
+  ThreadUse threads_;
 };
 
 }  // namespace manisoft_py

@@ -93,6 +93,12 @@ class ReachEnvTest(unittest.TestCase):
         self.assertTrue(np.array_equal(a, b))
         with self.assertRaisesRegex(ValueError, "unknown option"):
             env.reset(options={"index": 3})
+        with self.assertRaisesRegex(ValueError, r"reset: seed must be an integer in \[0, 2\^64\), got 'x' \(str\)"):
+            env.reset(seed="x")
+        # a list is an action (numpy.asarray), the same as the array
+        a = env.step([[1.0] * 3] * 20)[0]["end_effector"]
+        b = reference.step(np.ones((20, 3)))[0]["end_effector"]
+        self.assertTrue(np.array_equal(a, b))
         env.close()
         with self.assertRaisesRegex(RuntimeError, "closed"):
             env.step(np.zeros((20, 3)))

@@ -2,7 +2,9 @@
 observation (image and instruction, privileged state on request), the expert finishing a fixed
 scene, bit-identical replays, a rendered state matching the environment's own image, and bad input
 refused with a clear exception that changes nothing. Run: PYTHONPATH=<build>/python python3 -m unittest."""
+import gc
 import json
+import threading
 import unittest
 
 import numpy as np
@@ -180,6 +182,15 @@ class TaskEnvTest(unittest.TestCase):
             env.reset(options={"instruction": "paraphrased"})
         with self.assertRaisesRegex(ValueError, "not valid JSON"):
             env.reset(options={"scene": "{"})
+        scene = json.loads(env.scene_json())
+        scene["objects"].append(dict(scene["objects"][0]))  # a second object where the first stands
+        with self.assertRaisesRegex(ValueError, r"reset\(options\['scene'\]\): not a valid scene: interpenetration"):
+            env.reset(options={"scene": json.dumps(scene)})
+        scene["objects"].pop()
+        scene["objects"][0]["pose"]["position"][2] = 1e308
+        with self.assertRaisesRegex(ValueError, r"objects\[0\]\.pose position z = 1e\+308 is not on the table"):
+            env.reset(options={"scene": json.dumps(scene)})
+        self.assertEqual(env.step(good)[4]["steps"], 2)  # the refused resets changed nothing
         with self.assertRaisesRegex(RuntimeError, "render=True"):
             env.render()
         with self.assertRaisesRegex(ValueError, "unknown environment 'PICK'"):
@@ -191,6 +202,60 @@ class TaskEnvTest(unittest.TestCase):
         env.close()
         with self.assertRaisesRegex(RuntimeError, "closed"):
             env.step(good)
+
+    def test_bad_options_name_the_option_and_lists_are_actions(self):
+        env = manisoft.make_env("ALN", "clean", seed=0, privileged=True)
+        for options, pattern in [({"index": -1}, r"options\['index'\] must be an integer in \[0, 2\^64\), got -1$"),
+                                 ({"index": "3"}, r"options\['index'\] .* got '3' \(str\)"),
+                                 ({"index": 2.7}, r"options\['index'\] .* got 2.7$"),
+                                 ({"index": 2 ** 70}, r"options\['index'\] .* got 1180591620717411303424"),
+                                 ({"index": True}, r"options\['index'\] .* got True \(bool\)"),
+                                 ({"instruction_index": -2}, r"options\['instruction_index'\]"),
+                                 ({"split": 1}, r"options\['split'\] must be a string, got 1"),
+                                 ({"scene": None}, r"options\['scene'\] must be a string, got None \(NoneType\)")]:
+            with self.assertRaisesRegex(ValueError, pattern):
+                env.reset(options=options)
+        with self.assertRaisesRegex(ValueError, r"reset: seed must be an integer in \[0, 2\^64\), got -1"):
+            env.reset(seed=-1)
+        obs, _ = env.reset(options={"index": 1})  # the refused calls changed nothing: index 1 of seed 0
+        reference = manisoft.make_env("ALN", "clean", seed=0, privileged=True)
+        expected, _ = reference.reset(options={"index": 1})
+        self.assertEqual(obs["instruction"], expected["instruction"])
+        action = [0.0] * 61
+        obs, *_ = env.step(action)  # a list, as from json or a plain Python policy
+        expected, *_ = reference.step(np.zeros(61))
+        self.assertTrue(np.array_equal(obs["rod_nodes"], expected["rod_nodes"]))
+        with self.assertRaisesRegex(ValueError, r"step: action must be an array of numbers"):
+            env.step([0.0, [1.0, 2.0]])
+        with self.assertRaisesRegex(ValueError, r"shape \(61,\)"):
+            env.step((0.0,) * 60)
+
+    def test_a_rendering_environment_belongs_to_the_thread_that_reset_it(self):
+        made = {}
+
+        def worker():
+            env = manisoft.make_env("COLL", "clean", seed=0, render=True, camera=SMALL, privileged=True)
+            env.reset(options={"index": 0})
+            env.step(np.zeros(61))
+            made["env"] = env
+        t = threading.Thread(target=worker)
+        t.start()
+        t.join()
+        env = made.pop("env")
+        steps = env.step  # bound method: the call below comes from this (another) thread
+        with self.assertRaisesRegex(RuntimeError, "EGL context bound to the thread that first reset it"):
+            steps(np.zeros(61))
+        with self.assertRaisesRegex(RuntimeError, "bound to the thread"):
+            env.reset(options={"index": 1})
+        del env, steps  # deleted on this thread without close(): no abort (EGL_BAD_ACCESS before)
+        gc.collect()
+        # a non-rendering environment may move between threads
+        plain = manisoft.make_env("COLL", "clean", seed=0, render=False, privileged=True)
+        plain.reset(options={"index": 0})
+        t = threading.Thread(target=lambda: plain.step(np.zeros(61)))
+        t.start()
+        t.join()
+        self.assertEqual(plain.step(np.zeros(61))[4]["steps"], 2)
 
 
 if __name__ == "__main__":

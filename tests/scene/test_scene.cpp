@@ -218,6 +218,11 @@ TEST_CASE("inconsistent scenes are refused: unknown asset, index out of range, w
   REQUIRE_THAT(err([](SceneSpec& s) { s.objects[0].pose.rotation(0, 1) = 0.5; }), Catch::Contains("objects[0].pose.rotation is not a rotation"));
   REQUIRE_THAT(err([](SceneSpec& s) { s.objects[1].pose.translation.x() = 0.95; }), Catch::Contains("objects[1].pose position") && Catch::Contains("off the table"));
   REQUIRE_THAT(err([](SceneSpec& s) { s.arm_mount.base_position.z() = 1.4; }), Catch::Contains("arm_mount") && Catch::Contains("the mount is fixed"));
+  // on the table: the origin (the lowest point) from 1 cm below the top (0.75) to 50 cm above
+  REQUIRE_THAT(err([](SceneSpec& s) { s.objects[0].pose.translation.z() = 1e308; }),
+               Catch::Contains("x.json: objects[0].pose position z = 1e+308 is not on the table") && Catch::Contains("within [0.74, 1.25]"));
+  REQUIRE_THAT(err([](SceneSpec& s) { s.objects[1].pose.translation.z() = 0.7; }), Catch::Contains("objects[1].pose position z = 0.7 is not on the table"));
+  REQUIRE(err([](SceneSpec& s) { s.objects[0].pose.translation.z() = 0.745; }).empty());
   REQUIRE_THAT(err([](SceneSpec& s) {
                  s.task = Task::arr;
                  Relation r;
@@ -242,7 +247,7 @@ TEST_CASE("inconsistent scenes are refused: unknown asset, index out of range, w
   REQUIRE(!std::filesystem::exists(good + ".tmp"));
 }
 
-TEST_CASE("the validator accepts a hand-built scene and rejects overlap, a floating object, an unreachable object", "[scene]") {
+TEST_CASE("the validator accepts a hand-built scene and rejects overlap, a floating object, an unreachable object, a duplicate", "[scene]") {
   SceneValidator& v = sampler().validator();
   const auto ok = v.check(hand_built());
   INFO(ok.reason);
@@ -268,6 +273,12 @@ TEST_CASE("the validator accepts a hand-built scene and rejects overlap, a float
     const auto r = v.check(s);
     REQUIRE(!r.valid);
     REQUIRE_THAT(r.reason, Catch::Contains("no reachable grasp for object 0 (can/03)"));
+  }
+  {
+    SceneSpec s = hand_built();  // a second can where the first stands: require_valid names the file and the overlap
+    s.objects.push_back(s.objects[0]);
+    REQUIRE_THAT(error_of([&] { require_valid(s, v, "dup.json"); }), Catch::Contains("dup.json: not a valid scene: interpenetration"));
+    REQUIRE(error_of([&] { require_valid(hand_built(), v, "ok.json"); }).empty());
   }
   {
     SceneSpec s = hand_built();  // tilted 20 degrees on the table: topples or slides

@@ -109,6 +109,12 @@ class EglContext {
     }
   }
 
+  /// Makes the context current on the calling thread; false (nothing changed) when EGL refuses,
+  /// e.g. while the context is current on another thread.
+  bool try_make_current() const noexcept {
+    return eglGetCurrentContext() == context_ || eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_) == EGL_TRUE;
+  }
+
   EGLDisplay display() const { return display_; }
 
  private:

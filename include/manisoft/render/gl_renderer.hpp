@@ -544,24 +544,28 @@ class GlRenderer {
     glUniformMatrix3fv(current_uniforms().normal_matrix, 1, GL_FALSE, n.data());
   }
 
-  void release() {
+  /// Deletes the GL objects and the context. From a thread the context cannot be made current on
+  /// (it is current on another one) the objects are left to the context, which EGL destroys once
+  /// it is current nowhere: a renderer may be destroyed on any thread.
+  void release() noexcept {
     if (!context_) return;
-    context_->make_current();
-    for (auto& g : meshes_) detail_gl::destroy(g);
-    for (auto& g : triad_) detail_gl::destroy(g);
-    detail_gl::destroy(rod_gpu_);
-    targets_.destroy();
-    shadow_map_.destroy();
-    for (auto& light_set : programs_) {
-      for (auto& set : light_set) {
-        for (GLuint& p : set) {
-          if (p) glDeleteProgram(p);
-          p = 0;
+    if (context_->try_make_current()) {
+      for (auto& g : meshes_) detail_gl::destroy(g);
+      for (auto& g : triad_) detail_gl::destroy(g);
+      detail_gl::destroy(rod_gpu_);
+      targets_.destroy();
+      shadow_map_.destroy();
+      for (auto& light_set : programs_) {
+        for (auto& set : light_set) {
+          for (GLuint& p : set) {
+            if (p) glDeleteProgram(p);
+            p = 0;
+          }
         }
       }
+      if (shadow_program_) glDeleteProgram(shadow_program_);
+      shadow_program_ = 0;
     }
-    if (shadow_program_) glDeleteProgram(shadow_program_);
-    shadow_program_ = 0;
     context_.reset();
   }
 

@@ -1,7 +1,9 @@
 // Scene checks (every sampled scene is valid, checked before it is returned; the stability test
 // is RoboTwin 2.0's): a SceneSpec is
-//  - consistent: known asset ids of the right kind, finite poses on the table, goal indices in
-//    range and of the right kind (a COLL container has a receptacle), the world's arm mount;
+//  - consistent: known asset ids of the right kind, finite poses on the table (within its extent,
+//    the asset's origin, its lowest point, between 1 cm below and 50 cm above the top), goal
+//    indices in range and of the right kind (a COLL container has a receptacle), the world's arm
+//    mount;
 //  - free of interpenetration: after one rigid step no contact point (object, obstacle, table) is
 //    deeper than `penetration_tolerance` (the contact layer's narrow phase through RigidWorld);
 //  - at rest: settled in the rigid world for `settle_time`, no object moves more than `max_move`
@@ -73,6 +75,10 @@ inline void require_consistent(const SceneSpec& s, const AssetLibrary& lib, cons
       if (std::abs(d.x()) > s.table.half_x || std::abs(d.y()) > s.table.half_y)
         manisoft::detail::fail(where, ": ", field, ".pose position (", v[i].pose.translation.transpose(), ") is off the table (half sizes ",
                                s.table.half_x, " x ", s.table.half_y, " about (", s.table.top_center.transpose(), "))");
+      if (d.z() < -0.01 || d.z() > 0.5)
+        manisoft::detail::fail(where, ": ", field, ".pose position z = ", v[i].pose.translation.z(), " is not on the table: the asset's origin (its lowest point) ",
+                               "must be within [", s.table.top_center.z() - 0.01, ", ", s.table.top_center.z() + 0.5, "] (the top at ",
+                               s.table.top_center.z(), ")");
     }
   };
   if (!(s.table.half_x > 0) || !(s.table.half_y > 0) || !(s.table.thickness > 0) || !s.table.top_center.allFinite())
@@ -133,7 +139,8 @@ inline void require_consistent(const SceneSpec& s, const AssetLibrary& lib, cons
   }
 }
 
-/// Checks scenes; owns the inverse statics it solves with (not thread-safe: one per thread).
+/// Checks scenes; owns the inverse statics it solves with (not thread-safe: one per thread). A
+/// scene made by hand or loaded from a file is checked as a sampled one is with require_valid.
 class SceneValidator {
  public:
   explicit SceneValidator(const AssetLibrary& lib, ValidationSettings settings = {})
@@ -296,5 +303,12 @@ class SceneValidator {
   rod::InverseStatics<double> statics_;
   int ik_solves_ = 0;
 };
+
+/// Refuses a scene a sampler would not return (SceneValidator::check: consistent, every grasp and
+/// goal reachable, no interpenetration, at rest), naming `where` (file or caller) and the reason.
+inline void require_valid(const SceneSpec& s, SceneValidator& validator, const std::string& where) {
+  const ValidationResult r = validator.check(s);
+  if (!r.valid) manisoft::detail::fail(where, ": not a valid scene: ", r.reason);
+}
 
 }  // namespace manisoft::scene
