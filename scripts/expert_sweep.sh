@@ -3,13 +3,13 @@
 # setting (seed 0), JOBS at a time, one JSON line an episode into OUT, then a summary by task and
 # setting: successes, mean steps of the successes, failure reasons; the successes' lengths; COLL's
 # and ARR's successes by the category of the object moved, ARR's by relation.
-#   [TASKS="COLL ALN STK ARR"] [SETTINGS="clean randomized"] [JOBS=2] \
+#   [TASKS="COLL ALN STK ARR OVR"] [SETTINGS="clean randomized"] [JOBS=2] \
 #   scripts/expert_sweep.sh RUN_TASK OUT [LAST=199] [FIRST=0] [extra run_task flags...]
 set -euo pipefail
 run_task=$1 out=$2 last=${3:-199} first=${4:-0}
 shift $(( $# < 4 ? $# : 4 ))
 jobs=${JOBS:-2}
-for task in ${TASKS:-COLL ALN STK ARR}; do for setting in ${SETTINGS:-clean randomized}; do for i in $(seq "$first" "$last"); do
+for task in ${TASKS:-COLL ALN STK ARR OVR}; do for setting in ${SETTINGS:-clean randomized}; do for i in $(seq "$first" "$last"); do
   echo "$task $setting $i"
 done; done; done | xargs -P"$jobs" -L1 bash -c 'echo "$0 $1 $2 $("'"$run_task"'" --task $0 --setting $1 --index $2 --seed 0 --quiet '"$*"' | tail -1)"' > "$out"
 /usr/bin/python3 - "$out" <<'PY'

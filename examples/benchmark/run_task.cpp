@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   std::uint64_t index = 0, seed = 0;
   bool quiet = false;
   task::ExpertConfig expert_config;
-  app.add_option("--task", task_name, "COLL, ALN, STK or ARR")->check(CLI::IsMember(scene::task_names()));
+  app.add_option("--task", task_name, "COLL, ALN, STK, ARR or OVR")->check(CLI::IsMember(scene::task_names()));
   app.add_option("--setting", setting, "clean or randomized")->check(CLI::IsMember({"clean", "randomized"}));
   app.add_option("--index", index, "scene index (>= 0)");
   app.add_option("--seed", seed, "dataset seed (>= 0)");

@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
   std::string task = "COLL", setting = "clean", split = "train", out;
   std::uint64_t index = 0, seed = 0;
   bool quiet = false;
-  app.add_option("--task", task, "COLL, ALN, STK or ARR")->required()->check(CLI::IsMember(manisoft::scene::task_names()));
+  app.add_option("--task", task, "COLL, ALN, STK, ARR or OVR")->required()->check(CLI::IsMember(manisoft::scene::task_names()));
   app.add_option("--setting", setting, "clean or randomized")->required()->check(CLI::IsMember({"clean", "randomized"}));
   app.add_option("--index", index, "scene index (>= 0)")->required()->check(manisoft::cli::non_negative());
   app.add_option("--seed", seed, "dataset seed (>= 0)")->required()->check(manisoft::cli::non_negative());

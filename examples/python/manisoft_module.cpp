@@ -319,7 +319,7 @@ PYBIND11_MODULE(manisoft, m) {
         return manisoft::task::target_object(spec);
       },
       py::arg("scene"),
-      "The index of the object a scene's episode is about (COLL, ALN: the goal's object; STK: the top item; ARR: the first relation's "
+      "The index of the object a scene's episode is about (COLL, ALN, OVR: the goal's object; STK: the top item; ARR: the first relation's "
       "placed object), -1 when none");
   py::class_<manisoft::scene::SceneSampler>(m, "SceneSampler", "The benchmark's scenes (assets, layouts, instructions), drawn deterministically")
       .def(py::init<>())

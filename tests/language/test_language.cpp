@@ -234,7 +234,7 @@ TEST_CASE("randomized instructions: about 40, distinct, filled, seen and unseen 
 }
 
 TEST_CASE("the shipped data: >= 30 templates per task, nouns for every catalogue category", "[language]") {
-  for (const char* task : {"COLL", "ALN", "STK", "ARR"}) {
+  for (const char* task : {"COLL", "ALN", "STK", "ARR", "OVR"}) {
     const auto& t = library().templates.at(task);
     CAPTURE(task);
     CHECK(t.seen.size() + t.unseen.size() >= 30);
@@ -259,7 +259,8 @@ TEST_CASE("malformed language files are refused naming the file and the entry", 
       "between": {"seen": ["g {B} {C}"], "unseen": ["h {B} {C}"]}, "in_a_row": {"seen": ["i {B} {C}"], "unseen": ["j {B} {C}"]}})";
     return "{\"COLL\": " + coll + ", \"ALN\": " + aln +
            R"(, "STK": {"seen": ["Stack {ITEMS}."], "unseen": ["Pile {ITEMS}."]},
-               "ARR": {"seen": ["Put {A} {RELATION}."], "unseen": ["Move {A} {RELATION}."]}, )" + rel + "}";
+               "ARR": {"seen": ["Put {A} {RELATION}."], "unseen": ["Move {A} {RELATION}."]},
+               "OVR": {"seen": ["Carry {A} over {B}."], "unseen": ["Lift {A} over {B}."]}, )" + rel + "}";
   };
   const std::string coll = R"({"seen": ["Put {A} in {B}."], "unseen": ["Drop {A} in {B}."]})";
   const std::string aln = R"({"seen": ["Align {A}."], "unseen": ["Match {A}."]})";

@@ -93,10 +93,10 @@ class TaskEnvTest(unittest.TestCase):
 
     def test_the_registry_defines_tasks_horizon_and_control_step(self):
         tasks = manisoft.tasks()
-        self.assertEqual([t["name"] for t in tasks], ["COLL", "ALN", "STK", "ARR"])
+        self.assertEqual([t["name"] for t in tasks], ["COLL", "ALN", "STK", "ARR", "OVR"])
         coll = tasks[0]
         self.assertEqual(coll["conditions"], ["inside", "touching_container", "off_table", "released", "at_rest"])
-        self.assertEqual([t["by_category"] for t in tasks], [True, True, False, True])
+        self.assertEqual([t["by_category"] for t in tasks], [True, True, False, True, True])
         self.assertEqual(manisoft.HORIZON, 1500)
         self.assertEqual(manisoft.CONTROL_DT, 7 * 2e-4)  # 7 substeps of 0.2 ms
         for t in tasks:
@@ -104,13 +104,13 @@ class TaskEnvTest(unittest.TestCase):
             _, info = env.reset(options={"index": 0})
             self.assertEqual(list(info["conditions"]), t["conditions"])
             self.assertEqual(env.horizon, manisoft.HORIZON)
-        # The target object: COLL / ALN the goal's object, STK the top item, ARR the first placed object.
+        # The target object: COLL / ALN / OVR the goal's object, STK the top item, ARR the first placed object.
         sampler = manisoft.SceneSampler()
         for name, pick in (("COLL", lambda g: g["object"]), ("STK", lambda g: g["items"][-1]),
-                           ("ARR", lambda g: g["relations"][0]["objects"][0])):
+                           ("ARR", lambda g: g["relations"][0]["objects"][0]), ("OVR", lambda g: g["object"])):
             text = sampler.sample(name, "clean", 2, 0)
             self.assertEqual(manisoft.target_object(text), pick(json.loads(text)["goal"]), name)
-        with self.assertRaisesRegex(ValueError, "unknown environment 'PUSH' \\(available: COLL, ALN, STK, ARR, reach\\)"):
+        with self.assertRaisesRegex(ValueError, "unknown environment 'PUSH' \\(available: COLL, ALN, STK, ARR, OVR, reach\\)"):
             manisoft.make_env("PUSH")
 
     def test_same_seed_same_episode_and_actions_replay_bit_for_bit(self):

@@ -78,7 +78,7 @@ SceneSpec hand_built() {
 }  // namespace
 
 TEST_CASE("JSON round trip is exact for sampled scenes of every task and setting", "[scene]") {
-  for (Task t : {Task::coll, Task::aln, Task::stk, Task::arr})
+  for (Task t : {Task::coll, Task::aln, Task::stk, Task::arr, Task::ovr})
     for (Setting st : {Setting::clean, Setting::randomized}) {
       SceneSpec a = sampler().sample(request(t, st, 5, 11));
       a.instruction = "put the \"red\" can in the basket";
@@ -106,7 +106,8 @@ TEST_CASE("JSON round trip is exact for sampled scenes of every task and setting
       REQUIRE(b.instructions_seen == a.instructions_seen);
       REQUIRE(b.sampling.engine_seed == a.sampling.engine_seed);
       REQUIRE(goal_objects(b) == goal_objects(a));
-      if (t == Task::aln) require_same(b.goal.goal_pose, a.goal.goal_pose);
+      if (t == Task::aln || t == Task::ovr) require_same(b.goal.goal_pose, a.goal.goal_pose);
+      REQUIRE(b.goal.obstacle == a.goal.obstacle);
       if (t == Task::arr) REQUIRE(bit_equal(b.goal.relations[0].spots[0].y(), a.goal.relations[0].spots[0].y()));
     }
 }

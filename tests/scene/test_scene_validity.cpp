@@ -3,7 +3,8 @@
 // every object stays at rest in a rigid world stepped at the arm world's 2e-4 s (not the
 // validator's 1 ms); goals are well formed (COLL categories and containers, STK widths strictly
 // decreasing, ALN goal away from the start, ARR spot satisfying its relation with the task's
-// margins); clean scenes carry no obstacles or overrides, randomized ones 3-10 obstacles; and the
+// margins; OVR's obstacle tall and halfway between the object and its goal, footprints apart);
+// clean scenes carry no obstacles (but OVR's own) or overrides, randomized ones 3-10 more; and the
 // coverage of categories, relation kinds and of the reachable band's area. The default cases sample
 // 20-60 scenes per task and setting; the hidden "[slow]" case (ctest label slow) runs 1,000.
 #include <catch2/catch.hpp>
@@ -50,7 +51,7 @@ bool rects_overlap(const Rect& a, const Rect& b) {
 }
 
 struct Stats {
-  std::map<std::string, int> categories, containers, relations;
+  std::map<std::string, int> categories, containers, relations, walls;
   std::map<std::size_t, int> stack_sizes;
   std::set<std::pair<int, int>> band_cells_hit;
   int redraws = 0, scenes = 0;
@@ -101,8 +102,9 @@ void check_scene(const SceneSpec& s, const AssetLibrary& lib, Stats& st) {
     }
   }
   // setting
+  const std::size_t own = s.task == Task::ovr ? 1u : 0u;  // OVR's obstacle between
   if (s.setting == Setting::clean) {
-    REQUIRE(s.obstacles.empty());
+    REQUIRE(s.obstacles.size() == own);
     for (const auto& o : s.objects) {
       REQUIRE(!o.appearance.override_color);
       REQUIRE(std::abs(o.pose.rotation(0, 0) - 1.0) < 1e-12);  // canonical yaw 0
@@ -111,8 +113,8 @@ void check_scene(const SceneSpec& s, const AssetLibrary& lib, Stats& st) {
     REQUIRE(!s.instruction.empty());  // one canonical instruction
     REQUIRE(s.instructions_seen.empty());
   } else {
-    REQUIRE(s.obstacles.size() >= 3u);
-    REQUIRE(s.obstacles.size() <= 10u);
+    REQUIRE(s.obstacles.size() >= 3u + own);
+    REQUIRE(s.obstacles.size() <= 10u + own);
     REQUIRE(!s.instruction.empty());  // about 40, seen and unseen apart
     REQUIRE(s.instructions_seen.size() + s.instructions_unseen.size() >= 30u);
     REQUIRE(!s.instructions_unseen.empty());
@@ -136,6 +138,40 @@ void check_scene(const SceneSpec& s, const AssetLibrary& lib, Stats& st) {
       REQUIRE((s.goal.goal_pose.translation.head<2>() - xy(s.goal.object)).norm() >= 0.12);
       REQUIRE(s.goal.goal_pose.translation.z() == top);
       ++st.categories[c];
+      break;
+    }
+    case Task::ovr: {
+      REQUIRE(s.objects.size() == 1u);
+      const std::string c = category(s.goal.object);
+      REQUIRE((c == "bottle" || c == "candle_stick"));
+      REQUIRE(s.goal.goal_pose.translation.z() == top);
+      REQUIRE(s.goal.obstacle >= 0);
+      REQUIRE(s.goal.obstacle < static_cast<int>(s.obstacles.size()));
+      const auto& wall = s.obstacles[static_cast<std::size_t>(s.goal.obstacle)];
+      const auto& wa = lib.get(wall.asset_id, "t");
+      const auto& oa = lib.get(s.objects[0].asset_id, "t");
+      // tall: its box's top at least 0.15 m above the table, at most 0.25 m
+      const double height = wall.pose.act(wa.bounding_center).z() + wa.bounding_half_extents.z() - top;
+      REQUIRE(height >= 0.15);
+      REQUIRE(height <= 0.25 + 1e-12);
+      // between: its centre on the segment from the start to the goal, halfway
+      const Eigen::Vector2d a = xy(s.goal.object), b = s.goal.goal_pose.translation.head<2>(), w = wall.pose.translation.head<2>();
+      const double t = (w - a).dot(b - a) / (b - a).squaredNorm();
+      REQUIRE(std::abs(t - 0.5) < 1e-9);
+      REQUIRE((a + t * (b - a) - w).norm() < 1e-9);
+      // the max distance: the goal at most 0.5 m from the start
+      REQUIRE((b - a).norm() <= 0.5);
+      // out of the open gripper's way from home (0.5, 0) to the object: 9 cm plus its footprint
+      const Eigen::Vector2d home(0.5, 0.0), way = a - home;
+      const double u = std::clamp((w - home).dot(way) / way.squaredNorm(), 0.0, 1.0);
+      REQUIRE((home + u * way - w).norm() >= 0.09 + footprint_radius(wa));
+      // footprints apart: the object at its start and at its goal each clear of the obstacle's
+      REQUIRE(!rects_overlap(footprint(oa, s.objects[0].pose), footprint(wa, wall.pose)));
+      REQUIRE(!rects_overlap(footprint(oa, s.goal.goal_pose), footprint(wa, wall.pose)));
+      // the object stands at the marker as it stands at the start (only the position changes)
+      REQUIRE((s.goal.goal_pose.rotation - s.objects[0].pose.rotation).norm() == 0.0);
+      ++st.categories[c];
+      ++st.walls[wa.category];
       break;
     }
     case Task::stk: {
@@ -224,14 +260,15 @@ void run(int per_cell, bool report, const std::vector<Task>& tasks, bool kinds =
     }
   // coverage: every category the task allows appears (COLL with 100 scenes: the clean COLL cell
   // alone has 13 categories)
-  std::map<std::string, int> coll, arr, aln, stk, rel, containers;
+  std::map<std::string, int> coll, arr, aln, stk, ovr, rel, containers, walls;
   std::set<std::pair<int, int>> hit;
   std::map<std::size_t, int> sizes;
   for (auto& [key, st] : all) {
-    auto& dst = key.first == Task::coll ? coll : key.first == Task::arr ? arr : key.first == Task::aln ? aln : stk;
+    auto& dst = key.first == Task::coll ? coll : key.first == Task::arr ? arr : key.first == Task::aln ? aln : key.first == Task::ovr ? ovr : stk;
     for (auto& [c, n] : st.categories) dst[c] += n;
     for (auto& [c, n] : st.relations) rel[c] += n;
     for (auto& [c, n] : st.containers) containers[c] += n;
+    for (auto& [c, n] : st.walls) walls[c] += n;
     for (auto& [c, n] : st.stack_sizes) sizes[c] += n;
     hit.insert(st.band_cells_hit.begin(), st.band_cells_hit.end());
   }
@@ -250,6 +287,13 @@ void run(int per_cell, bool report, const std::vector<Task>& tasks, bool kinds =
     for (const char* k : {"left_of", "right_of", "in_front_of", "behind", "next_to", "between", "in_a_row"}) {
       INFO("relation " << k);
       REQUIRE(rel[k] > 0);
+    }
+  }
+  if (has(Task::ovr)) {
+    for (const auto& c : ovr_categories()) REQUIRE(ovr[c] > 0);
+    for (const auto& c : ovr_obstacle_categories()) {
+      INFO("OVR obstacle category " << c);
+      REQUIRE(walls[c] > 0);
     }
   }
   if (has(Task::stk)) {
@@ -281,10 +325,13 @@ TEST_CASE("STK: with items within 0.3 m, stacks of 2, 3 and 4 items appear and a
   run(30, false, {Task::stk}, true, {2u, 3u, 4u}, wide);
 }
 TEST_CASE("ARR: 40 clean + 40 randomized scenes valid, every category and relation kind appears", "[scene]") { run(40, false, {Task::arr}); }
+TEST_CASE("OVR: 30 clean + 30 randomized scenes valid, a tall obstacle halfway between the object and its goal", "[scene]") {
+  run(30, false, {Task::ovr});
+}
 TEST_CASE("clean placements cover the reachable band (15 scenes per task and setting)", "[scene]") {
   run(15, false, {Task::coll, Task::aln, Task::stk, Task::arr}, false);
 }
 
-TEST_CASE("1,000 sampled scenes per task and setting are valid (slow)", "[.][slow]") { run(1000, true, {Task::coll, Task::aln, Task::stk, Task::arr}); }
+TEST_CASE("1,000 sampled scenes per task and setting are valid (slow)", "[.][slow]") { run(1000, true, {Task::coll, Task::aln, Task::stk, Task::arr, Task::ovr}); }
 
 }  // namespace test_scene_validity

@@ -1,4 +1,4 @@
-// The four tasks' success predicates (include/manisoft/task/: coll, aln, stk, arr) on hand-built states:
+// The five tasks' success predicates (include/manisoft/task/: coll, aln, stk, arr, ovr) on hand-built states:
 // each holds where the definition says it must, and fails just outside every tolerance, while an
 // object is still held or moving, and for the wrong order or side.
 #include <catch2/catch.hpp>
@@ -119,8 +119,8 @@ TEST_CASE("COLL: centre of mass inside the receptacle, touching it and not the t
 
 TEST_CASE("registry: every task by name, its conditions as its predicate lists them", "[tasks]") {
   namespace scene = manisoft::scene;
-  REQUIRE(scene::all_tasks.size() == 4);
-  const std::array<const char*, 4> names{"COLL", "ALN", "STK", "ARR"};
+  REQUIRE(scene::all_tasks.size() == 5);
+  const std::array<const char*, 5> names{"COLL", "ALN", "STK", "ARR", "OVR"};
   for (std::size_t k = 0; k < scene::all_tasks.size(); ++k) {
     const task::TaskInfo info = task::task_info(scene::all_tasks[k]);
     CHECK(info.name == names[k]);
@@ -190,6 +190,58 @@ TEST_CASE("ALN: position within 2 cm, orientation within 0.2 rad modulo the obje
   objects[0].held = false;
   objects[0].angular_velocity = Vector3d(0, 0, 0.15);
   CHECK_FALSE(task::aligned(snap(objects), 0, goal, task::Symmetry::none()));
+}
+
+TEST_CASE("OVR: position within 2 cm of the marker, upright within 0.2 rad at any yaw, released, at rest", "[tasks]") {
+  const task::Ovr::Goal goal{0, Vector3d(0.45, 0.2, 0.75)};
+  std::vector<task::ObjectState> objects{object_at(goal.position + Vector3d(0.012, -0.015, 0.0))};  // 1.92 cm off
+  objects[0].pose.rotation = yaw(2.5);  // any yaw
+  const auto unmet = [&](bool open = true) { return task::Ovr::evaluate(snap(objects, open), goal).unmet(); };
+  CHECK(unmet().empty());
+  CHECK(task::Ovr::holds_at_start(task::Ovr::evaluate(snap(objects), goal)));
+  objects[0].pose.translation = goal.position + Vector3d(0.012, -0.0165, 0.0);  // 2.04 cm off
+  CHECK(unmet() == "position");
+  CHECK_FALSE(task::Ovr::holds_at_start(task::Ovr::evaluate(snap(objects), goal)));
+  objects[0].pose.translation = goal.position + Vector3d(0, 0, 0.0199);  // height counts too
+  CHECK(unmet().empty());
+  objects[0].pose.translation = goal.position + Vector3d(0, 0, 0.0201);
+  CHECK(unmet() == "position");
+  objects[0].pose.translation = goal.position;
+  // Tilted about a horizontal axis: 0.19 rad passes, 0.21 rad fails, whatever the yaw.
+  const Vector3d axis = Vector3d(1, 1, 0).normalized();
+  objects[0].pose.rotation = Eigen::AngleAxisd(0.19, axis).toRotationMatrix() * yaw(-1.0);
+  CHECK(unmet().empty());
+  objects[0].pose.rotation = Eigen::AngleAxisd(0.21, axis).toRotationMatrix() * yaw(-1.0);
+  CHECK(unmet() == "upright");
+  objects[0].pose.rotation = Eigen::AngleAxisd(kPi / 2, Vector3d::UnitY()).toRotationMatrix();  // lying on its side
+  CHECK(unmet() == "upright");
+  CHECK(task::Ovr::holds_at_start(task::Ovr::evaluate(snap(objects), goal)));  // at the marker: no task
+  objects[0].pose.rotation = yaw(0.3);
+  objects[0].held = true;
+  CHECK(unmet() == "released");
+  objects[0].held = false;
+  CHECK(unmet(false) == "released");  // the gripper closed
+  objects[0].linear_velocity = Vector3d(0, 0.011, 0);
+  CHECK(unmet() == "at_rest");
+  objects[0].linear_velocity = Vector3d(0, 0.009, 0);
+  CHECK(unmet().empty());
+  CHECK_THROWS_WITH(task::Ovr::evaluate(snap(objects), task::Ovr::Goal{1, goal.position}), Catch::Contains("object index 1 is out of range"));
+  // The goal from a scene: the object and the obstacle between must exist.
+  manisoft::scene::SceneSpec spec;
+  spec.task = manisoft::scene::Task::ovr;
+  spec.objects.resize(2);
+  spec.obstacles.resize(1);
+  spec.goal.object = 1;
+  spec.goal.obstacle = 0;
+  spec.goal.goal_pose.translation = goal.position;
+  const manisoft::scene::AssetLibrary library;
+  CHECK(task::Ovr::goal(spec, library).position == goal.position);
+  CHECK(task::target_object(spec) == 1);
+  spec.goal.obstacle = 1;
+  CHECK_THROWS_WITH(task::Ovr::goal(spec, library), Catch::Contains("OVR goal: obstacle 1 is not one of the scene's 1 obstacles"));
+  spec.goal.obstacle = 0;
+  spec.goal.object = 2;
+  CHECK_THROWS_WITH(task::Ovr::goal(spec, library), Catch::Contains("OVR goal: object 2 is not one of the scene's 2 objects"));
 }
 
 TEST_CASE("STK: largest to smallest, centred within 3 cm, each on the one below, released, at rest", "[tasks]") {

@@ -22,8 +22,8 @@ namespace manisoft::language {
 
 /// The task and which objects (indices into the scene's objects) fill its placeholders.
 struct TaskSlots {
-  std::string task;          ///< "COLL", "ALN", "STK", "ARR"
-  std::vector<int> objects;  ///< COLL {A, B}; ALN {A}; STK items, largest first; ARR {A, B} or {A, B, C}
+  std::string task;          ///< "COLL", "ALN", "STK", "ARR", "OVR"
+  std::vector<int> objects;  ///< COLL {A, B}; ALN {A}; STK items, largest first; ARR {A, B} or {A, B, C}; OVR {A, B}: B the obstacle
   std::string relation;      ///< ARR: a relation kind of Library::relations ("left_of", "between", ...)
 };
 
@@ -85,7 +85,7 @@ std::string fill(const Library& library, const TaskSlots& slots, const std::stri
     }
     text = detail::replace_all(text, "RELATION", relation);
     text = detail::replace_all(text, "A", pick(0));
-    if (slots.task == "COLL") text = detail::replace_all(text, "B", pick(1));
+    if (slots.task == "COLL" || slots.task == "OVR") text = detail::replace_all(text, "B", pick(1));
   }
   (void)library;
   return detail::sentence(text);
@@ -94,9 +94,9 @@ std::string fill(const Library& library, const TaskSlots& slots, const std::stri
 /// Checks that `slots` fits its task and the scene (throws InvalidInput naming what is wrong).
 inline void validate(const Library& library, const TaskSlots& slots, std::size_t object_count) {
   const auto it = library.templates.find(slots.task);
-  if (it == library.templates.end()) ::manisoft::detail::fail("unknown task '", slots.task, "': expected COLL, ALN, STK or ARR");
+  if (it == library.templates.end()) ::manisoft::detail::fail("unknown task '", slots.task, "': expected COLL, ALN, STK, ARR or OVR");
   std::size_t lo = 1, hi = 1;
-  if (slots.task == "COLL") lo = hi = 2;
+  if (slots.task == "COLL" || slots.task == "OVR") lo = hi = 2;
   if (slots.task == "STK") lo = 2, hi = 8;
   if (slots.task == "ARR") {
     if (!library.relations.count(slots.relation)) ::manisoft::detail::fail("ARR: unknown relation '", slots.relation, "'");

@@ -30,7 +30,7 @@ struct Split {
 /// The tasks and the placeholders their templates may use.
 inline const std::map<std::string, std::set<std::string>>& task_placeholders() {
   static const std::map<std::string, std::set<std::string>> p{
-      {"COLL", {"A", "B"}}, {"ALN", {"A"}}, {"STK", {"ITEMS"}}, {"ARR", {"A", "RELATION"}}};
+      {"COLL", {"A", "B"}}, {"ALN", {"A"}}, {"STK", {"ITEMS"}}, {"ARR", {"A", "RELATION"}}, {"OVR", {"A", "B"}}};
   return p;
 }
 

@@ -33,7 +33,8 @@ inline std::vector<language::SceneObject> language_objects(const SceneSpec& s, c
   return out;
 }
 
-/// The language layer's slots of the scene's goal (ARR: its first relation).
+/// The language layer's slots of the scene's goal (ARR: its first relation; OVR: the object and
+/// the obstacle between, which language_objects lists after the objects).
 inline language::TaskSlots task_slots(const SceneSpec& s) {
   language::TaskSlots slots;
   slots.task = std::string(to_string(s.task));
@@ -44,6 +45,8 @@ inline language::TaskSlots task_slots(const SceneSpec& s) {
     slots.relation = std::string(to_string(r.kind));
     slots.objects.push_back(r.objects.front());
     slots.objects.insert(slots.objects.end(), r.references.begin(), r.references.end());
+  } else if (s.task == Task::ovr) {
+    slots.objects = {s.goal.object, static_cast<int>(s.objects.size()) + s.goal.obstacle};
   } else {
     slots.objects = goal_objects(s);
   }

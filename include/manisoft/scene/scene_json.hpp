@@ -296,6 +296,11 @@ inline nlohmann::json to_json(const SceneSpec& s) {
       g["symmetry"] = Json{{"kind", kind}, {"order", s.goal.symmetry.order}};
       break;
     }
+    case Task::ovr:
+      g["object"] = s.goal.object;
+      g["goal_pose"] = json_detail::pose(s.goal.goal_pose);
+      g["obstacle"] = s.goal.obstacle;
+      break;
     case Task::stk: g["items"] = s.goal.items; break;
     case Task::arr: {
       g["relations"] = Json::array();
@@ -329,7 +334,7 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
   const std::string fmt = rd.str(j, "format", "");
   if (fmt != scene_format) rd.fail("format", "is '" + fmt + "', expected '" + scene_format + "'");
   SceneSpec s;
-  s.task = rd.name_of(j, "task", "", std::array<std::pair<const char*, Task>, 4>{{{"COLL", Task::coll}, {"ALN", Task::aln}, {"STK", Task::stk}, {"ARR", Task::arr}}});
+  s.task = rd.name_of(j, "task", "", std::array<std::pair<const char*, Task>, 5>{{{"COLL", Task::coll}, {"ALN", Task::aln}, {"STK", Task::stk}, {"ARR", Task::arr}, {"OVR", Task::ovr}}});
   s.setting = rd.name_of(j, "setting", "", std::array<std::pair<const char*, Setting>, 2>{{{"clean", Setting::clean}, {"randomized", Setting::randomized}}});
   s.split = rd.name_of(j, "split", "", std::array<std::pair<const char*, Split>, 2>{{{"train", Split::train}, {"eval", Split::eval}}});
   s.index = rd.u64(j, "index", "");
@@ -415,6 +420,12 @@ inline SceneSpec from_json(const nlohmann::json& j, const std::string& where) {
       if (s.goal.symmetry.order < 1) rd.fail("goal.symmetry.order", "must be >= 1");
       break;
     }
+    case Task::ovr:
+      rd.only(g, "goal", {"object", "goal_pose", "obstacle"});
+      s.goal.object = rd.integer(g, "object", "goal");
+      s.goal.goal_pose = rd.pose(g, "goal_pose", "goal");
+      s.goal.obstacle = rd.integer(g, "obstacle", "goal");
+      break;
     case Task::stk:
       rd.only(g, "goal", {"items"});
       s.goal.items = rd.ints(g, "items", "goal");

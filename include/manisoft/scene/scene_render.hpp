@@ -2,7 +2,7 @@
 // the Python environment's camera image and the dataset's episode images draw): floor, the spec's
 // table (size, texture, colours), the arm mount, the soft arm sagging forward near its rest shape
 // with its gripper, every object and obstacle drawn from its asset's visual parts (the spec's colour
-// override replaces the main part's colour and texture), the ALN goal marker, the spec's lighting
+// override replaces the main part's colour and texture), the ALN and OVR goal marker, the spec's lighting
 // and cameras. Object ids: 1 floor, 2 table, 3 mount, 4 arm, 5 gripper, then 6 + i for object i,
 // then the obstacles, then the goal marker.
 #pragma once
@@ -95,7 +95,7 @@ inline render::tabletop::TabletopScene make_render_scene(const SceneSpec& s, con
   render::SceneDescription& d = t.scene;
   render::FrameState& f = t.frame;
   d.goal_marker.object_id = next_id;
-  if (s.task == Task::aln) f.goal_pose = s.goal.goal_pose;
+  if (s.task == Task::aln || s.task == Task::ovr) f.goal_pose = s.goal.goal_pose;
   d.lighting.intensity = static_cast<float>(s.lighting.intensity);
   d.lighting.color = s.lighting.color.cast<float>();
   d.lighting.direction = s.lighting.direction;

@@ -1,4 +1,4 @@
-// Scene samplers of the four tasks in the clean and randomized settings (paper sections 3.2,
+// Scene samplers of the five tasks in the clean and randomized settings (paper sections 3.2,
 // 3.3 and 3.5, figure 4c):
 //  COLL  a designated object of one of the paper's 13 categories + a container (a basket);
 //  ALN   a bottle, shoe or candle stick + a goal pose (upright, a yaw) on the table;
@@ -6,7 +6,11 @@
 //        largest (a set of dishes), goal largest first;
 //  ARR   one relation, each kind equally often (left_of, right_of, in_front_of, behind, next_to with
 //        2-3 objects; between, in_a_row with 3) among Rubik's cube / bottle / pen cup / shoe, and a
-//        free spot for it.
+//        free spot for it;
+//  OVR   a bottle or candle stick + a goal marker (upright, the object's yaw) on the table
+//        at most ovr_max_goal_distance away, with a tall obstacle (ovr_obstacle_categories,
+//        ovr_min_obstacle_height to ovr_max_obstacle_height) standing halfway between them,
+//        footprints apart, and out of the way from the arm's home to the object (home_keepout).
 // clean: only the task's objects, canonical appearance and lighting, upright at yaw 0, positions
 // uniform over the reachable area (ReachBand at each object's grasp height), so they spread
 // evenly over the reachable table area; randomized: also 3-10 obstacles anywhere on the table,
@@ -55,6 +59,17 @@ inline const std::vector<std::string>& aln_categories() {
   static const std::vector<std::string> c{"bottle", "shoe", "candle_stick"};
   return c;
 }
+/// OVR's objects: ALN's upright round ones (a shoe, held at its side, slips out of the grip on
+/// the long high carry).
+inline const std::vector<std::string>& ovr_categories() {
+  static const std::vector<std::string> c{"bottle", "candle_stick"};
+  return c;
+}
+/// OVR's obstacle that stands between the object and its goal: tall, footprints of about 0.1-0.2 m.
+inline const std::vector<std::string>& ovr_obstacle_categories() {
+  static const std::vector<std::string> c{"vase", "thermos", "pitcher", "speaker", "watering_can"};
+  return c;
+}
 inline const std::vector<std::string>& stk_categories() {
   static const std::vector<std::string> c{"bowl", "plate"};
   return c;
@@ -66,6 +81,7 @@ inline const std::vector<std::string>& arr_categories() {
 
 struct SamplerSettings {
   int max_attempts = 200;           ///< draws before giving up (an error naming the request)
+  int ovr_max_attempts = 2000;      ///< the same for OVR, whose layout (goal, obstacle between, the way from home) rejects most draws
   int placement_tries = 200;        ///< rejection-sampling tries per placement
   double gap = 0.02;                ///< m between footprints
   double gripper_keepout = 0.08;    ///< m: footprint radius at least this around objects to grasp
@@ -77,6 +93,12 @@ struct SamplerSettings {
   geometry::RelationTolerances relations;  ///< ARR: the success predicate's margins
   double relation_margin = 0.02;    ///< m: the ARR spot holds with margins this much tighter, the start fails with them this much wider
   int min_obstacles = 3, max_obstacles = 10;
+  /// OVR: the obstacle between is at least this tall (above the table top), well over the
+  /// expert's lift_height with its clearances, so a carry straight across would hit it, and at
+  /// most ovr_max_obstacle_height (the arm's reach above it with the object held).
+  double ovr_min_obstacle_height = 0.15;  ///< m
+  double ovr_max_obstacle_height = 0.25;  ///< m
+  double ovr_max_goal_distance = 0.5;     ///< m from the object's start (longer carries outlast the horizon)
   /// The open gripper at the arm's home pose (task::TaskEnvConfig::home: grasp centre above
   /// (0.50, 0), fingertips 0.095 m above the table top): an object or obstacle taller than
   /// home_clear_height keeps its footprint home_keepout (the gripper's half diagonal and a margin)
@@ -113,7 +135,8 @@ class SceneSampler {
   /// with its instructions (scene_instructions.hpp); SceneSpec::sampling counts the redraws.
   SceneSpec sample(const SampleRequest& q) {
     std::vector<std::string> rejections;
-    for (int attempt = 0; attempt < settings_.max_attempts; ++attempt) {
+    const int attempts = q.task == Task::ovr ? settings_.ovr_max_attempts : settings_.max_attempts;
+    for (int attempt = 0; attempt < attempts; ++attempt) {
       const std::uint64_t es = engine_seed(q.split, q.task, q.setting, q.index, q.seed, attempt);
       std::optional<SceneSpec> s = draw(q, es);
       std::string why = "placement failed";
@@ -133,7 +156,7 @@ class SceneSampler {
       rejections.push_back(why.substr(0, why.find(':')));
     }
     manisoft::detail::fail("SceneSampler: no valid ", to_string(q.task), " ", to_string(q.setting), " scene for index ", q.index, ", seed ", q.seed,
-                           " in ", settings_.max_attempts, " draws");
+                           " in ", attempts, " draws");
   }
 
   /// One unchecked draw with engine seed `es` (nullopt when a placement found no free spot).
@@ -154,6 +177,7 @@ class SceneSampler {
       case Task::aln: ok = draw_aln(s, d); break;
       case Task::stk: ok = draw_stk(s, d); break;
       case Task::arr: ok = draw_arr(s, d); break;
+      case Task::ovr: ok = draw_ovr(s, d); break;
     }
     if (!ok) return std::nullopt;
     if (rnd && !add_obstacles(s, d)) return std::nullopt;
@@ -260,9 +284,11 @@ class SceneSampler {
     s.lighting.ambient_intensity = d.uniform(0.25, 0.45);
   }
 
-  /// Places 3-10 obstacles; false when fewer than the drawn count found room.
+  /// Places 3-10 obstacles (after those the task placed); false when fewer than the drawn count
+  /// found room.
   bool add_obstacles(SceneSpec& s, Draw& d) {
     const int n = d.integer(settings_.min_obstacles, settings_.max_obstacles);
+    const auto placed_before = static_cast<int>(s.obstacles.size());
     const auto& all = library_.obstacles();
     const double top = s.table.top_center.z();
     for (int k = 0; k < n; ++k) {
@@ -282,7 +308,7 @@ class SceneSampler {
         break;
       }
     }
-    return static_cast<int>(s.obstacles.size()) == n;
+    return static_cast<int>(s.obstacles.size()) - placed_before == n;
   }
 
   /// Whether `obj` fits into `container` with `fit_clearance` to spare: it stands on the floor
@@ -349,6 +375,49 @@ class SceneSampler {
       s.goal.goal_pose = upright(obj, *p, s.table.top_center.z(), d.uniform(-0.5 * 3.14159265358979323846, 0.5 * 3.14159265358979323846));
       s.goal.symmetry = asset_symmetry(obj);
       discs_.push_back({*p, r});  // keeps obstacles off the goal
+      return true;
+    }
+    return false;
+  }
+
+  /// OVR: the object, then a goal spot far enough that the obstacle fits halfway between them
+  /// (gap to each footprint), then the obstacle there. The obstacle keeps home_keepout from the
+  /// line from home_xy to the object (the open gripper's way to it: what the arm carries over
+  /// is the obstacle between the object and its goal).
+  bool draw_ovr(SceneSpec& s, Draw& d) {
+    const assets::Asset& obj = pick_instance(d, d.pick(ovr_categories()));
+    std::vector<const assets::Asset*> tall;
+    for (const auto* a : library_.category(d.pick(ovr_obstacle_categories())))
+      if (asset_height(*a) >= settings_.ovr_min_obstacle_height && asset_height(*a) <= settings_.ovr_max_obstacle_height) tall.push_back(a);
+    if (tall.empty()) return false;
+    const assets::Asset& wall = *d.pick(tall);
+    const double h = grasp_height(obj);
+    const int o = place_object(s, d, obj, h, true);
+    if (o < 0) return false;
+    const double r = keepout(obj, true), rw = footprint_radius(wall);
+    const math::Pose<double>& start = s.objects[static_cast<std::size_t>(o)].pose;
+    const Eigen::Vector2d from = start.translation.head<2>();
+    for (int t = 0; t < settings_.placement_tries; ++t) {
+      const auto p = reachable_spot(s, d, h, r);
+      if (!p) return false;
+      const Eigen::Vector2d mid = 0.5 * (from + *p), way = from - settings_.home_xy;
+      const double along = way.squaredNorm() > 1e-12 ? std::clamp((mid - settings_.home_xy).dot(way) / way.squaredNorm(), 0.0, 1.0) : 0.0;
+      const double dist = (*p - from).norm();
+      if (dist < 2 * (r + rw + settings_.gap) || dist > settings_.ovr_max_goal_distance || !on_table(s, mid, rw) || !free(mid, rw) ||
+          (settings_.home_xy + along * way - mid).norm() < rw + settings_.home_keepout)
+        continue;
+      s.goal.object = o;
+      s.goal.goal_pose = start;
+      s.goal.goal_pose.translation.head<2>() = *p;
+      s.goal.symmetry = asset_symmetry(obj);
+      discs_.push_back({*p, r});  // keeps obstacles off the goal
+      PlacedAsset w;
+      w.asset_id = wall.id;
+      w.pose = upright(wall, mid, s.table.top_center.z(), s.setting == Setting::randomized ? d.uniform(-3.14159265358979323846, 3.14159265358979323846) : 0.0);
+      if (s.setting == Setting::randomized && d.chance(0.5)) recolor(w.appearance, d);
+      s.obstacles.push_back(w);
+      s.goal.obstacle = static_cast<int>(s.obstacles.size()) - 1;
+      discs_.push_back({mid, rw});
       return true;
     }
     return false;

@@ -34,9 +34,9 @@ namespace manisoft::scene {
 
 /// The benchmark's tasks (paper section 3.2; each defined in include/manisoft/task/, listed in
 /// task/registry.hpp).
-enum class Task { coll, aln, stk, arr };
+enum class Task { coll, aln, stk, arr, ovr };
 /// Every task, in the benchmark's order.
-inline constexpr std::array<Task, 4> all_tasks{Task::coll, Task::aln, Task::stk, Task::arr};
+inline constexpr std::array<Task, 5> all_tasks{Task::coll, Task::aln, Task::stk, Task::arr, Task::ovr};
 enum class Setting { clean, randomized };
 enum class Split { train, eval };
 
@@ -46,6 +46,7 @@ inline std::string_view to_string(Task t) {
     case Task::aln: return "ALN";
     case Task::stk: return "STK";
     case Task::arr: return "ARR";
+    case Task::ovr: return "OVR";
   }
   return "?";
 }
@@ -64,7 +65,7 @@ E parse_name(std::string_view what, std::string_view name, const std::array<E, N
 }
 }  // namespace detail
 
-/// Every task's name, in the benchmark's order ("COLL", "ALN", "STK", "ARR").
+/// Every task's name, in the benchmark's order ("COLL", "ALN", "STK", "ARR", "OVR").
 inline std::vector<std::string> task_names() {
   std::vector<std::string> out;
   for (const Task t : all_tasks) out.emplace_back(to_string(t));
@@ -156,8 +157,11 @@ struct Goal {
   int object = -1;
   int container = -1;
   // ALN: bring objects[object] to goal_pose (asset frame -> world), judged modulo symmetry.
+  // OVR: bring objects[object] to goal_pose's position, upright, over obstacles[obstacle] (which
+  // stands between its start and the goal).
   math::Pose<double> goal_pose;
   Symmetry symmetry;
+  int obstacle = -1;
   // STK: item indices from the largest (bottom) to the smallest (top).
   std::vector<int> items;
   // ARR: every relation must hold.
@@ -220,12 +224,13 @@ inline std::vector<PlacedItem> list_items(const SceneSpec& s) {
   return out;
 }
 
-/// The object indices the goal names, in the goal's order (COLL: object, container; ALN: object;
-/// STK: items; ARR: every relation's objects then references).
+/// The object indices the goal names, in the goal's order (COLL: object, container; ALN, OVR:
+/// object; STK: items; ARR: every relation's objects then references).
 inline std::vector<int> goal_objects(const SceneSpec& s) {
   switch (s.task) {
     case Task::coll: return {s.goal.object, s.goal.container};
-    case Task::aln: return {s.goal.object};
+    case Task::aln:
+    case Task::ovr: return {s.goal.object};
     case Task::stk: return s.goal.items;
     case Task::arr: {
       std::vector<int> out;

@@ -12,7 +12,7 @@
 //  - solvable in principle: each object to grasp has an annotated grasp (assets/asset.hpp, the
 //    variants of candidate_grasps) whose tool pose has an equilibrium within the actuation limits
 //    (rod::InverseStatics) with the rod clear of the table top and of every obstacle's bounding
-//    box; the goal (COLL: above the container's opening; ALN: the goal pose; STK: above the
+//    box; the goal (COLL: above the container's opening; ALN, OVR: the goal pose; STK: above the
 //    bottom item; ARR: each relation's spot) is reachable the same way.
 #pragma once
 
@@ -101,6 +101,12 @@ inline void require_consistent(const SceneSpec& s, const AssetLibrary& lib, cons
     case Task::aln:
       check_index(s.goal.object, "goal.object");
       check_pose(s.goal.goal_pose, "goal.goal_pose");
+      break;
+    case Task::ovr:
+      check_index(s.goal.object, "goal.object");
+      check_pose(s.goal.goal_pose, "goal.goal_pose");
+      if (s.goal.obstacle < 0 || s.goal.obstacle >= static_cast<int>(s.obstacles.size()))
+        manisoft::detail::fail(where, ": goal.obstacle = ", s.goal.obstacle, " is out of range: the scene has ", s.obstacles.size(), " obstacles");
       break;
     case Task::stk:
       if (s.goal.items.size() < 2) manisoft::detail::fail(where, ": goal.items has ", s.goal.items.size(), " items, at least 2 are needed");
@@ -250,9 +256,10 @@ class SceneValidator {
         if (!place_reachable(s, at)) return "container opening of object " + std::to_string(s.goal.container) + " (" + c.id + ") not reachable";
         return {};
       }
-      case Task::aln: {
+      case Task::aln:
+      case Task::ovr: {
         if (auto w = need_grasp(s.goal.object); !w.empty()) return w;
-        if (!grasp_reachable(s, obj(s.goal.object), s.goal.goal_pose)) return "ALN goal pose not reachable";
+        if (!grasp_reachable(s, obj(s.goal.object), s.goal.goal_pose)) return std::string(to_string(s.task)) + " goal pose not reachable";
         return {};
       }
       case Task::stk: {

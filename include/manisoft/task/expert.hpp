@@ -1,4 +1,4 @@
-// The expert of the four ManiSoft tasks (paper section 3.4: a rule-based planner per task whose
+// The expert of the five ManiSoft tasks (paper section 3.4: a rule-based planner per task whose
 // SE(3) waypoints and gripper states are tracked by the model executor).
 //
 //   task::Expert expert(env);       // env: a task::TaskEnv
@@ -13,7 +13,9 @@
 //   STK   items[k] onto items[k-1] for k = 1, 2, ... (on the receptacle of the item below, or on
 //         its top), the item below read when the move starts; released with the fingertips
 //         stack_finger_clearance above the item below's top (the item drops the rest);
-//   ARR   each relation's object at the free spot the scene gives for it (Relation::spots).
+//   ARR   each relation's object at the free spot the scene gives for it (Relation::spots);
+//   OVR   the object at the marker's position as it stands (the "via" carry lifts it over the
+//         obstacle between: corridor_top).
 // Orientation: kept as the object stands (translation only) except ALN's yaw.
 // Grasp: among the asset's annotated grasps, each also turned half a turn about the fingers' axis
 // (the parallel gripper is symmetric) and turned about the object's axis as its symmetry allows
@@ -436,7 +438,8 @@ class Expert {
     const auto& s = env_->spec();
     switch (s.task) {
       case scene::Task::coll:
-      case scene::Task::aln: return 1;
+      case scene::Task::aln:
+      case scene::Task::ovr: return 1;
       case scene::Task::stk: return static_cast<int>(s.goal.items.size()) - 1;
       case scene::Task::arr: {
         int n = 0;
@@ -470,6 +473,11 @@ class Expert {
         Pose p = s.goal.goal_pose;
         p.translation.z() += config_.place_clearance;
         p.rotation = nearest_equivalent(now.rotation, p.rotation, s.goal.symmetry);
+        return {s.goal.object, p};
+      }
+      case scene::Task::ovr: {
+        Pose p = state_of(s.goal.object).pose;
+        p.translation = s.goal.goal_pose.translation + Vec3(0, 0, config_.place_clearance);
         return {s.goal.object, p};
       }
       case scene::Task::stk: {

@@ -1,5 +1,5 @@
 // The registry of the benchmark's tasks: the one list of task types (coll.hpp, aln.hpp, stk.hpp,
-// arr.hpp) and the one switch from a scene's task to its type. Everything that needs a task's
+// arr.hpp, ovr.hpp) and the one switch from a scene's task to its type. Everything that needs a task's
 // name, predicate, condition names or target object asks here: the task environment, the
 // programs, the Python module (and through it the Python scripts).
 //
@@ -22,6 +22,7 @@
 #include "manisoft/task/arr.hpp"
 #include "manisoft/task/coll.hpp"
 #include "manisoft/task/conditions.hpp"
+#include "manisoft/task/ovr.hpp"
 #include "manisoft/task/stk.hpp"
 #include "manisoft/task/success.hpp"
 
@@ -47,6 +48,7 @@ decltype(auto) visit_task(scene::Task task, F&& f) {
     case scene::Task::aln: return std::forward<F>(f)(Aln{});
     case scene::Task::stk: return std::forward<F>(f)(Stk{});
     case scene::Task::arr: return std::forward<F>(f)(Arr{});
+    case scene::Task::ovr: return std::forward<F>(f)(Ovr{});
   }
   ::manisoft::detail::fail("unknown task ", static_cast<int>(task));
 }
@@ -70,7 +72,8 @@ inline TaskInfo task_info(scene::Task task) {
 }
 
 /// The object an episode is about, for per-category tables (COLL, ALN: the goal's object; STK:
-/// the top item, moved first; ARR: the first relation's placed object); -1 when none.
+/// the top item, moved first; ARR: the first relation's placed object; OVR: the carried object);
+/// -1 when none.
 inline int target_object(const scene::SceneSpec& spec) {
   return visit_task(spec.task, [&spec]<TaskType T>(T) { return T::target_object(spec); });
 }

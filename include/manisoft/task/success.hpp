@@ -4,7 +4,7 @@
 // gripper is open and holds something), the tolerances of every predicate, the failure reasons,
 // "released" and "at rest" (ManiSkill's static test) and `SuccessTracker`, which turns a per-step
 // predicate into an episode's outcome. The predicates themselves are the tasks' own (coll.hpp,
-// aln.hpp, stk.hpp, arr.hpp; the list in registry.hpp); the paper defines no success criterion,
+// aln.hpp, stk.hpp, arr.hpp, ovr.hpp; the list in registry.hpp); the paper defines no success criterion,
 // so they follow the best rigid-arm benchmarks (RoboTwin 2.0's placement and stacking checks,
 // LIBERO's On/In predicates, ManiSkill's "static" test), documented in docs/tasks.md.
 //
@@ -80,6 +80,10 @@ struct Tolerances {
   // ALN: distance of the asset origins and angle between the orientations (modulo symmetry).
   double aln_position = 0.02;         ///< m
   double aln_orientation = 0.2;       ///< rad
+  // OVR: the object's z axis from world z (it is judged upright at any yaw: the marker shows
+  // where, the obstacle is the task); ALN's orientation tolerance, which an object standing on
+  // its base meets unless it leans on something or lies down.
+  double ovr_upright = 0.2;           ///< rad
   // STK: horizontal offset of each item's centre of mass from the one below.
   double stk_horizontal = 0.03;       ///< m
   // ARR: the relations' margins (geometry/spatial_relation.hpp).

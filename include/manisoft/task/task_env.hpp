@@ -263,7 +263,7 @@ class TaskEnv {
     world_.reset();
   }
 
-  using GoalVariant = std::variant<Coll::Goal, Aln::Goal, Stk::Goal, Arr::Goal>;
+  using GoalVariant = std::variant<Coll::Goal, Aln::Goal, Stk::Goal, Arr::Goal, Ovr::Goal>;
   /// The task type whose Goal `G` is.
   template <typename G>
   using task_of = typename std::decay_t<G>::Task;
