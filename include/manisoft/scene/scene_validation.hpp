@@ -77,8 +77,7 @@ inline void require_consistent(const SceneSpec& s, const AssetLibrary& lib, cons
                                s.table.half_x, " x ", s.table.half_y, " about (", s.table.top_center.transpose(), "))");
       if (d.z() < -0.01 || d.z() > 0.5)
         manisoft::detail::fail(where, ": ", field, ".pose position z = ", v[i].pose.translation.z(), " is not on the table: the asset's origin (its lowest point) ",
-                               "must be within [", s.table.top_center.z() - 0.01, ", ", s.table.top_center.z() + 0.5, "] (the top at ",
-                               s.table.top_center.z(), ")");
+                               "must be from 0.01 m below to 0.5 m above the table top (z = ", s.table.top_center.z(), ")");
     }
   };
   if (!(s.table.half_x > 0) || !(s.table.half_y > 0) || !(s.table.thickness > 0) || !s.table.top_center.allFinite())
