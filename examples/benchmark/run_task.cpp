@@ -1,17 +1,20 @@
 // run_task: one expert episode of a ManiSoft task (include/manisoft/task/: TaskEnv + Expert).
 //   run_task --task COLL|ALN|STK|ARR --setting clean|randomized --index I --seed S
 //            [--split train|eval] [--scene scene.json] [--save-scene out.json] [--trace out.csv] [--quiet]
+//            [--torque-noise SIGMA --noise-hold K]
 // Samples the scene (or reads --scene), prints the instruction and each waypoint as it is
 // reached, and ends its output with one line of JSON:
 //   {"task":..., "setting":..., "index":..., "seed":..., "success":true|false, "steps":N,
-//    "failure":null|"reason", "expert":null|"why it gave up", "cpu_s":..., "object": the target
+//    "failure":null|"reason", "expert":null|"why it gave up", "torque_noise", "noise_hold", "cpu_s":..., "object": the target
 //    object's asset id, "relation", "instruction", "unmet": the predicate's conditions that did
 //    not hold at the end}
 // --trace writes one CSV row per control step, step 0 the state after reset, in world_demo's layout
 // (render_scene --scene S --trace T replays it): step, time, phase (the expert's phase: 0 approach,
 // 1 descend, 2 close, 3 carry, 4 lower, 5 open, 6 retract, 7 idle, 8 failed), S, finger width,
 // held (object index or -1), gripper pose (position, quaternion w x y z), every rod node, every
-// object's pose (object<i>_px..._qz). --save-scene writes the scene JSON. Exit 0 whether or not
+// object's pose (object<i>_px..._qz). --save-scene writes the scene JSON. --torque-noise adds
+// Gaussian noise of that standard deviation to every entry of the expert's torques, redrawn every
+// --noise-hold control steps (a learner's error; seeded by the scene's index and seed). Exit 0 whether or not
 // the episode succeeds; 1 on an error (a malformed scene file, no valid scene), 2 on bad flags.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -19,6 +22,7 @@
 #include <cstdio>
 #include <ctime>
 #include <fstream>
+#include <random>
 #include <string>
 #include <string_view>
 
@@ -36,6 +40,8 @@ int main(int argc, char** argv) {
   std::string task_name = "COLL", setting = "clean", split = "train", scene_file, save_scene, trace_file;
   std::uint64_t index = 0, seed = 0;
   bool quiet = false;
+  double noise_sigma = 0;
+  int noise_hold = 1;
   task::ExpertConfig expert_config;
   app.add_option("--task", task_name, "COLL, ALN, STK, ARR or OVR")->check(CLI::IsMember(scene::task_names()));
   app.add_option("--setting", setting, "clean or randomized")->check(CLI::IsMember({"clean", "randomized"}));
@@ -44,6 +50,9 @@ int main(int argc, char** argv) {
   app.add_option("--split", split, "train (default) or eval")->check(CLI::IsMember({"train", "eval"}));
   app.add_option("--scene", scene_file, "scene JSON to run instead of sampling one")->check(CLI::ExistingFile);
   app.add_option("--save-scene", save_scene, "write the episode's scene JSON here");
+  app.add_option("--torque-noise", noise_sigma, "Gaussian noise (N m, standard deviation per entry) added to the expert's torques, a learner's error")
+      ->check(manisoft::cli::non_negative());
+  app.add_option("--noise-hold", noise_hold, "control steps each noise draw is held (1: fresh every step)")->check(manisoft::cli::positive());
   app.add_option("--trace", trace_file, "CSV file: one row per control step (world_demo's layout)");
   app.add_flag("--quiet", quiet, "print only the JSON line");
   app.add_option("--path-speed", expert_config.path_peak_speed, "expert: peak end-effector speed of a path with the gripper empty, m/s")->check(manisoft::cli::positive());
@@ -147,10 +156,19 @@ int main(int argc, char** argv) {
       write_row(static_cast<int>(expert.phase()), env.world().gripper().state());
     }
     task::TaskEnv::Array3 torques;
+    // The noise of --torque-noise: seeded by the scene (index, seed), so a run is repeatable.
+    task::TaskEnv::Array3 noise = task::TaskEnv::Array3::Zero(env.arm_model().rod.n_elements, 3);
+    std::mt19937_64 noise_rng(spec.index * 0x9E3779B97F4A7C15ull + spec.seed + 0x401);
+    std::normal_distribution<double> gaussian(0.0, 1.0);
     int s = 0;
     std::size_t printed = 0;
     while (!env.done()) {
       expert.act(torques, s);
+      if (noise_sigma > 0) {
+        if (env.info().step % noise_hold == 0)
+          for (auto& v : noise.reshaped()) v = noise_sigma * gaussian(noise_rng);
+        torques += noise;
+      }
       env.step(torques, s);
       for (; printed < expert.events().size(); ++printed) {
         const auto& e = expert.events()[printed];
@@ -192,10 +210,10 @@ int main(int argc, char** argv) {
     for (const auto& c : env.conditions())
       if (!c.holds) unmet.push_back(std::string(c.name));
     std::printf("{\"task\":\"%s\",\"setting\":\"%s\",\"index\":%llu,\"seed\":%llu,\"success\":%s,\"success_at_end\":%s,\"steps\":%ld,\"failure\":%s,"
-                "\"expert\":%s,\"cpu_s\":%.3f,\"episode_cpu_s\":%.3f,\"object\":%s,\"relation\":%s,\"instruction\":%s,\"unmet\":%s}\n",
+                "\"expert\":%s,\"torque_noise\":%g,\"noise_hold\":%d,\"cpu_s\":%.3f,\"episode_cpu_s\":%.3f,\"object\":%s,\"relation\":%s,\"instruction\":%s,\"unmet\":%s}\n",
                 std::string(scene::to_string(spec.task)).c_str(), std::string(scene::to_string(spec.setting)).c_str(),
                 static_cast<unsigned long long>(spec.index), static_cast<unsigned long long>(spec.seed), info.success ? "true" : "false",
-                env.success_at_end() ? "true" : "false", info.step, failure.c_str(), why.c_str(), cpu, episode_cpu, object.c_str(),
+                env.success_at_end() ? "true" : "false", info.step, failure.c_str(), why.c_str(), noise_sigma, noise_hold, cpu, episode_cpu, object.c_str(),
                 relation.c_str(), quoted(spec.instruction).c_str(), unmet.dump().c_str());
   } catch (const manisoft::Error& e) {
     std::fprintf(stderr, "run_task: %s\n", e.what());

@@ -5,10 +5,12 @@
 
 #include "../support/scratch_dir.hpp"
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -191,6 +193,39 @@ TEST_CASE("reach environment targets are deterministic per seed", "[executor][en
   CHECK(a.reset(12).target.translation != b.reset(11).target.translation);
   CHECK(manisoft::env::parse_target_set("equilibria") == manisoft::env::TargetSet::equilibria);
   CHECK_THROWS_WITH(manisoft::env::parse_target_set("tabel"), Catch::Contains("'tabel'"));
+}
+
+TEST_CASE("no action sequence within the actuation limits diverges the reach environment", "[executor][env][stability]") {
+  // The limits allow 19 x 150 N m of bending couple at the base, 58 /m of curvature on a rod with
+  // EI = 49 N m^2: the arm coils and whips at 100-300 m/s, above what the explicit step at dt
+  // resolves in one piece; the rod steps such states in pieces (rod::CosseratRod::advance).
+  using Env = manisoft::env::ReachEnv<manisoft::rod::damping::AnalyticalLinear>;
+  Env env({}, manisoft::rod::damping::AnalyticalLinear<double>(0.1));
+  const int n = env.n_elements();
+  const auto& limits = env.config().limits;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> uniform(-1, 1);
+  const std::array<const char*, 5> kinds{"upper bound", "lower bound", "bang-bang every 10 steps", "uniform random", "random signs"};
+  for (int kind = 0; kind < 5; ++kind) {
+    env.reset(3);
+    Env::Array3 action(n, 3);
+    int steps = 0;
+    for (; steps < 300; ++steps) {
+      for (int k = 0; k < n; ++k)
+        for (int c = 0; c < 3; ++c) {
+          double s = 1;
+          if (kind == 1) s = -1;
+          if (kind == 2) s = (steps / 10) % 2 ? -1 : 1;
+          if (kind == 3) s = uniform(rng);
+          if (kind == 4) s = uniform(rng) < 0 ? -1 : 1;
+          action(k, c) = s * limits.limit(c);
+        }
+      if (env.step(action).info.diverged) break;
+    }
+    CAPTURE(kinds[kind]);
+    CHECK(steps == 300);
+    CHECK(env.rod().state().positions.allFinite());
+  }
 }
 
 TEST_CASE("the model executor reaches and holds table targets", "[executor][reach]") {

@@ -164,4 +164,33 @@ TEST_CASE("identical inputs give bit-identical runs", "[rod][determinism]") {
   CHECK(same_state(a, b));
 }
 
+TEST_CASE("a step whose rotation rate exceeds 0.1 rad per dt is taken in equal pieces, bit for bit as steps of dt / m", "[rod][stability]") {
+  // An undamped rod twisting at 1,200 rad/s about its axis: |omega| dt = 0.24 rad at dt = 2e-4 s,
+  // so the step is 3 pieces of dt / 3. The reference is a rod built with dt / 3 stepped 3 times
+  // (its own rotation per step is 0.08 rad: one piece each).
+  const double dt = 2e-4;
+  auto spun = [](SimpleRod& rod) {
+    rod.state().angular_velocities.col(2).setConstant(1200.0);
+    rod.state().angular_velocities(0, 2) = 0;
+  };
+  SimpleRod whole(RodParameters<double>{}, dt);
+  SimpleRod pieces(RodParameters<double>{}, dt / 3);
+  spun(whole);
+  spun(pieces);
+  whole.step();
+  CHECK(whole.last_pieces() == 3);
+  pieces.step(3);
+  CHECK(pieces.last_pieces() == 1);
+  CHECK(whole.state().positions == pieces.state().positions);
+  CHECK(whole.state().directors == pieces.state().directors);
+  CHECK(whole.state().angular_velocities == pieces.state().angular_velocities);
+  CHECK(whole.state().velocities == pieces.state().velocities);
+  CHECK(whole.step_count() == 1);
+  // A slow state keeps one piece: the step is the plain explicit step.
+  SimpleRod slow(RodParameters<double>{}, dt);
+  slow.state().angular_velocities.col(2).setConstant(400.0);  // 0.08 rad per dt
+  slow.step();
+  CHECK(slow.last_pieces() == 1);
+}
+
 }  // namespace test_rod_input
