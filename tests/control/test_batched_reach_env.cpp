@@ -4,8 +4,6 @@
 // step, and the worker pool handing a worker's exception to the caller.
 #include <catch2/catch.hpp>
 
-#include "../support/allocation_counter.hpp"
-
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -16,6 +14,8 @@
 
 #include "manisoft/core/worker_pool.hpp"
 #include "manisoft/env/batched_reach_env.hpp"
+
+#include "../support/allocation_counter.hpp"  // after Eigen: it replaces the allocation functions mm_malloc.h declares
 
 namespace test_batched_reach_env {  // per-file namespace: the group's tests build as one unity translation unit
 
