@@ -279,6 +279,10 @@ TEST_CASE("a worker's exception reaches the caller and the pool runs on", "[env]
   auto counting = [&](int part, int) { ran[std::size_t(part)] = 10 + part; };
   pool.run(counting);
   CHECK(ran == std::vector<int>{10, 11, 12});
+  auto two = [&](int part, int parts) { ran[std::size_t(part)] = 20 + parts; };
+  pool.run(two, 2);  // the third part's worker does nothing
+  CHECK(ran == std::vector<int>{22, 22, 12});
+  CHECK_THROWS_WITH(pool.run(two, 4), Catch::Contains("parts = 4 must be in [1, threads = 3]"));
   CHECK_THROWS_WITH(manisoft::WorkerPool(0), Catch::Contains("threads = 0 must be >= 1"));
 }
 

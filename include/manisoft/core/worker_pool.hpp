@@ -2,7 +2,8 @@
 // for batched environments that step many independent simulations per call.
 //
 //   WorkerPool pool(2);                       // threads started once, joined by the destructor
-//   pool.run([&](int part, int parts) { ... });   // part 0 on the caller, parts 1.. on workers
+//   pool.run(job);        // job(part, parts): part 0 on the caller, parts 1.. on the workers
+//   pool.run(job, 1);     // fewer parts (a small batch): here no worker is woken
 //
 // `threads` = 1 runs every job on the caller's thread and starts no worker. run() returns when
 // every part has finished; an exception thrown by any part is rethrown on the caller (the lowest
@@ -43,22 +44,26 @@ class WorkerPool {
 
   int threads() const { return threads_; }
 
-  /// Calls job(part, threads()) for every part, part 0 on the calling thread; rethrows the first
-  /// part's exception once all parts are done.
+  /// Calls job(part, parts) for every part < parts (1 <= parts <= threads(); default: all), part 0
+  /// on the calling thread; the workers beyond `parts` do no work. Rethrows the first part's
+  /// exception once all parts are done.
   template <typename Job>
-  void run(Job& job) {
-    job_ = [](void* context, int part, int parts) { (*static_cast<Job*>(context))(part, parts); };
+  void run(Job& job, int parts = 0) {
+    if (parts == 0) parts = threads_;
+    if (parts < 1 || parts > threads_) detail::fail("WorkerPool::run: parts = ", parts, " must be in [1, threads = ", threads_, "]");
+    job_ = [](void* context, int part, int n) { (*static_cast<Job*>(context))(part, n); };
     context_ = &job;
-    if (threads_ > 1) {
+    parts_ = parts;
+    if (parts > 1) {
       {
         std::lock_guard lock(mutex_);
-        pending_ = threads_ - 1;
+        pending_ = parts - 1;
         ++generation_;
       }
       wake_.notify_all();
     }
     run_part(0);
-    if (threads_ > 1) {
+    if (parts > 1) {
       std::unique_lock lock(mutex_);
       done_.wait(lock, [this] { return pending_ == 0; });
     }
@@ -73,7 +78,7 @@ class WorkerPool {
  private:
   void run_part(int part) {
     try {
-      job_(context_, part, threads_);
+      job_(context_, part, parts_);
     } catch (...) {
       errors_[std::size_t(part)] = std::current_exception();
     }
@@ -86,6 +91,7 @@ class WorkerPool {
       wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
       if (stop_) return;
       seen = generation_;
+      if (part >= parts_) continue;  // not needed for this job
       lock.unlock();
       run_part(part);
       lock.lock();
@@ -102,6 +108,7 @@ class WorkerPool {
   std::uint64_t generation_ = 0;  ///< guarded by mutex_: one more per job
   int pending_ = 0;               ///< guarded by mutex_: workers still running the job
   bool stop_ = false;             ///< guarded by mutex_
+  int parts_ = 1;                 ///< parts of the running job: set before the workers wake
   void (*job_)(void*, int, int) = nullptr;
   void* context_ = nullptr;
 };

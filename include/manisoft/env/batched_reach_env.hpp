@@ -72,7 +72,7 @@ class BatchedReachEnv {
       for (std::size_t i = chunk_begin(part, parts); i < chunk_begin(part + 1, parts); ++i)
         arms_[i] = std::make_unique<Env>(config, damping, action_settings);
     };
-    pool_.run(build);
+    pool_.run(build, active_threads());
     rows_ = arms_[0]->action_space().rows();
     observed_ = int(control::make_arm_observation<double>(config.rod.n_elements, config.observe_stride).node_indices.size());
     const typename Env::Array3 zero = Env::Array3::Zero(rows_, 3);
@@ -124,7 +124,7 @@ class BatchedReachEnv {
     auto job = [this, actions](int part, int parts) {
       for (std::size_t i = chunk_begin(part, parts); i < chunk_begin(part + 1, parts); ++i) step_arm(i, actions);
     };
-    pool_.run(job);
+    pool_.run(job, active_threads());
   }
 
   std::span<const double> end_effector() const { return end_effector_; }
@@ -168,6 +168,9 @@ class BatchedReachEnv {
       manisoft::detail::fail("BatchedReachEnv::reset: ", what, " hold ", size, " values, expected batch_size = ", arms_.size());
   }
 
+  /// Threads a call uses: no more than there are arms.
+  int active_threads() const { return std::min(pool_.threads(), int(arms_.size())); }
+
   std::size_t chunk_begin(int part, int parts) const { return arms_.size() * std::size_t(part) / std::size_t(parts); }
 
   void reset_marked(std::span<const std::uint64_t> seeds) {
@@ -175,7 +178,7 @@ class BatchedReachEnv {
       for (std::size_t i = chunk_begin(part, parts); i < chunk_begin(part + 1, parts); ++i)
         if (do_reset_[i]) reset_arm(i, seeds[i]);
     };
-    pool_.run(job);
+    pool_.run(job, active_threads());
     started_ = true;
   }
 
