@@ -51,17 +51,15 @@ class WorkerPool {
   void run(Job& job, int parts = 0) {
     if (parts == 0) parts = threads_;
     if (parts < 1 || parts > threads_) detail::fail("WorkerPool::run: parts = ", parts, " must be in [1, threads = ", threads_, "]");
-    job_ = [](void* context, int part, int n) { (*static_cast<Job*>(context))(part, n); };
-    context_ = &job;
-    parts_ = parts;
-    if (parts > 1) {
-      {
-        std::lock_guard lock(mutex_);
-        pending_ = parts - 1;
-        ++generation_;
-      }
-      wake_.notify_all();
+    {
+      std::lock_guard lock(mutex_);  // a worker left out of the last job may still read parts_
+      job_ = [](void* context, int part, int n) { (*static_cast<Job*>(context))(part, n); };
+      context_ = &job;
+      parts_ = parts;
+      pending_ = parts - 1;
+      if (parts > 1) ++generation_;
     }
+    if (parts > 1) wake_.notify_all();
     run_part(0);
     if (parts > 1) {
       std::unique_lock lock(mutex_);
@@ -108,8 +106,8 @@ class WorkerPool {
   std::uint64_t generation_ = 0;  ///< guarded by mutex_: one more per job
   int pending_ = 0;               ///< guarded by mutex_: workers still running the job
   bool stop_ = false;             ///< guarded by mutex_
-  int parts_ = 1;                 ///< parts of the running job: set before the workers wake
-  void (*job_)(void*, int, int) = nullptr;
+  int parts_ = 1;                 ///< guarded by mutex_ (written): parts of the running job
+  void (*job_)(void*, int, int) = nullptr;  ///< written under mutex_ while no worker runs
   void* context_ = nullptr;
 };
 
