@@ -334,7 +334,7 @@ int main(int argc, char** argv) {
         current = from + smooth * (to - from);
         world.control_step(current, ph.s);
         ++control_step;
-        max_weld = std::max(max_weld, world.gripper().weld_elastic_force());
+        max_weld = std::max(max_weld, world.gripper().grip_force());
         write_row(ph.s);
       }
       const Vec3 g = world.gripper().grasp_point(world.rigid());

@@ -463,7 +463,7 @@ TEST_CASE("a held line's acceleration stays within the grip: a tall bottle is no
     run_expert(e, expert, s, 100000, [&](manisoft::task::ExpertPhase phase) {
       if (phase != manisoft::task::ExpertPhase::carry) return;
       if (!e.world().gripper().held()) c.slipped = true;
-      c.max_force = std::max(c.max_force, e.world().gripper().weld_elastic_force());
+      c.max_force = std::max(c.max_force, e.world().gripper().grip_force());
     });
     return c;
   };

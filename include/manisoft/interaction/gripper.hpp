@@ -16,31 +16,34 @@
 // mass properties stay those of the open gripper. The contact solver sees the finger surfaces
 // move (RigidGeom::surface_velocity), so a closing finger pushes what it meets at its own speed.
 //
-// Grasp mechanism (a weld with checks, not friction): while the fingers close, the first dynamic
+// Grasp mechanism (a weld with a friction limit): while the fingers close, the first dynamic
 // body that both fingers touch (within touch_tolerance; ties: lowest id) is welded to the gripper
 // at its current relative pose, and the fingers stop there (finger_width() = the gap at the
-// grasp). The weld is a stiff 6-DoF spring-damper (like the coupling):
-//   F = -k (x_o - x_a) - c (v_o - v_a),  M = -k_r Log(R_o R_a^T) - c_r (w_o - w_g)     (lab)
+// grasp). The weld is a stiff 6-DoF spring-damper (k, c = zeta 2 sqrt(k m_eff); k_r, c_r on the
+// pair's smallest inertia I_eff), integrated implicitly (backward Euler on the pair's relative
+// motion, Box2D's soft step), so it is stable at any stiffness and time step:
+//   F = -(k dx + (c + h k) dv) / (1 + h (c + h k) / m_eff),   dx = x_o - x_a, dv = v_o - v_a
+//   M = -(k_r dtheta + (c_r + h k_r) dw) / (1 + h (c_r + h k_r) / I_eff),  dtheta = Log(R_o R_a^T)
 // on the object at its centre of mass x_o, the opposite force at x_o on the gripper and the
 // opposite torque (so the pair conserves momentum); x_a, R_a: the object's pose frozen in the
-// gripper frame at the grasp. The held object keeps colliding with everything (table, obstacles,
-// other objects, the rod) but the gripper itself while it is held (RigidWorld::
-// set_excluded_contact): the weld is the grip, up to its force limit, and the fingers stopped
-// within touch_tolerance of it (or a palm it touches) would only add contacts that fight the weld
-// and are re-detected at every step of a carry; once it slips or is released, they are found
-// again. Closing on nothing closes the fingers to 0 and grasps nothing (a closed gripper picks up
-// nothing it bumps into later); S 1 -> 0 removes the weld at once and the fingers open at the
-// stroke speed. A real grip holds only up to its friction force:
-// when the spring force |k dx| exceeds max_hold_force (or |k_r dtheta| max_hold_torque) the object
-// slips out and the grasp ends (reported by `slipped()`); the fingers then stay where they stopped
-// until opened. Opening is force-limited: while anything presses on a finger's outer face (the
-// wall of a bowl the closed fingers were lowered into), the fingers stop, and go on opening once
-// the arm lifts them clear.
+// gripper frame at the grasp; m_eff, I_eff: the pair's reduced mass and inertia. The held object
+// keeps colliding with everything (table, obstacles, other objects, the rod) but the gripper
+// itself while it is held (RigidWorld::set_excluded_contact): the weld is the grip, and the
+// fingers stopped within touch_tolerance of it (or a palm it touches) would only add contacts
+// that fight the weld and are re-detected at every step of a carry; once it slips or is released,
+// they are found again. Closing on nothing closes the fingers to 0 and grasps nothing (a closed
+// gripper picks up nothing it bumps into later); S 1 -> 0 removes the weld at once and the fingers
+// open at the stroke speed.
 //
-// Stability (explicit forces at dt = 2e-4 s): k and k_r are capped at grasp time so that
-// sqrt(k / m_eff) dt and sqrt(k_r / I_eff) dt stay <= max_omega_dt (0.25) on the pair's reduced
-// mass and smallest principal inertia; damping is zeta = 0.7 of critical. For the defaults and a
-// 0.1 kg, 5 cm cube (I = 4.2e-5 kg m^2): k = 2e4 N/m (omega dt = 0.11), k_r = 6.7 N m/rad (capped).
+// The grip is friction: the fingers press with a normal force N each; the grip carries at most
+// max_hold_force = 2 mu N (40 N for N = 25 N, mu = 0.8) and max_hold_torque (1.5 N m: that force
+// at a 3.75 cm arm, about the width of the 4 cm finger pads). A weld force or
+// torque beyond them is capped there and the object slides (its anchor follows it: kinetic
+// friction); an object that has slid max_slide (2 cm) from where it was grasped slips out and the
+// grasp ends (reported by `slipped()`); the fingers then stay where they stopped until opened.
+// Opening is force-limited: while anything presses on a finger's outer face (the wall of a bowl
+// the closed fingers were lowered into), the fingers stop, and go on opening once the arm lifts
+// them clear.
 #pragma once
 
 #include <algorithm>
@@ -75,9 +78,9 @@ struct ParallelGripperParameters {
   double weld_stiffness = 2e4;            ///< N/m
   double weld_rotational_stiffness = 50;  ///< N m/rad
   double weld_damping_ratio = 0.7;
-  double max_omega_dt = 0.25;      ///< cap on the weld's stiffness (explicit stability)
   double max_hold_force = 40;      ///< N: grip friction limit (2 fingers x 25 N x mu 0.8)
-  double max_hold_torque = 1.5;    ///< N m
+  double max_hold_torque = 1.5;    ///< N m: max_hold_force at a 3.75 cm arm (about the finger pads' width)
+  double max_slide = 0.02;         ///< m: an object that slides this far in the grip slips out
   double stroke_time = 0.1;        ///< s: fingers from open to closed (the gap closes at open_width / stroke_time)
   double touch_tolerance = 5e-4;   ///< m: a finger this near a body touches it (the grasp's check)
 
@@ -94,8 +97,7 @@ struct ParallelGripperParameters {
     manisoft::detail::require_positive("ParallelGripper weld_stiffness", weld_stiffness);
     manisoft::detail::require_positive("ParallelGripper weld_rotational_stiffness", weld_rotational_stiffness);
     manisoft::detail::require_non_negative("ParallelGripper weld_damping_ratio", weld_damping_ratio);
-    manisoft::detail::require_positive("ParallelGripper max_omega_dt", max_omega_dt);
-    if (!(max_omega_dt <= 0.5)) manisoft::detail::fail("ParallelGripper max_omega_dt = ", max_omega_dt, " must be <= 0.5");
+    manisoft::detail::require_positive("ParallelGripper max_slide", max_slide);
     manisoft::detail::require_positive("ParallelGripper max_hold_force", max_hold_force);
     manisoft::detail::require_positive("ParallelGripper max_hold_torque", max_hold_torque);
     manisoft::detail::require_positive("ParallelGripper stroke_time", stroke_time);
@@ -156,8 +158,9 @@ class ParallelGripper {
     Vec3 anchor_local = Vec3::Zero();
     Mat3 rotation_local = Mat3::Identity();
     double k = 0, k_r = 0, c = 0, c_r = 0;
+    double m_eff = 0, i_eff = 0;  ///< the pair's reduced mass and inertia (the implicit weld's)
+    Vec3 grasp_anchor_local = Vec3::Zero();  ///< anchor_local at the grasp (the object slides from there)
     Vec3 weld_force = Vec3::Zero(), weld_torque = Vec3::Zero();
-    double elastic_force = 0;
     bool grasped_now = false, released_now = false, slipped = false;
   };
   void save(Snapshot& out) const { out = m_; }
@@ -189,10 +192,13 @@ class ParallelGripper {
   bool closing() const { return m_.state == 1 && !m_.held && !m_.stopped && m_.gap > 0; }
   /// Commanded open and the fingers not yet fully open.
   bool opening() const { return m_.state == 0 && m_.gap < params_.open_width; }
-  /// The weld wrench on the held object in the last step (lab) and its elastic parts.
+  /// The weld wrench on the held object in the last step (lab); grip_force() = |weld_force()|,
+  /// at most max_hold_force (the object slides when it is there).
   const Vec3& weld_force() const { return m_.weld_force; }
   const Vec3& weld_torque() const { return m_.weld_torque; }
-  double weld_elastic_force() const { return m_.elastic_force; }
+  double grip_force() const { return m_.weld_force.norm(); }
+  /// How far the held object has slid in the grip since it was grasped, m.
+  double slide() const { return (m_.anchor_local - m_.grasp_anchor_local).norm(); }
   /// Events of the last pre_step.
   bool grasped_now() const { return m_.grasped_now; }
   bool released_now() const { return m_.released_now; }
@@ -210,7 +216,6 @@ class ParallelGripper {
     m_.grasped_now = m_.released_now = m_.slipped = false;
     m_.weld_force.setZero();
     m_.weld_torque.setZero();
-    m_.elastic_force = 0;
     if (m_.command != m_.state) {
       m_.state = m_.command;
       if (m_.state == 0) {
@@ -229,10 +234,10 @@ class ParallelGripper {
       m_.gap_rate = gap_rate;
       place_fingers(world, moved);
       if (moved && m_.state == 1) {
-        if (auto b = touched_by_both(world)) start_weld(world, *b, dt);
+        if (auto b = touched_by_both(world)) start_weld(world, *b);
       }
     }
-    if (m_.held) apply_weld(world);
+    if (m_.held) apply_weld(world, dt);
     exclude_held(world);
   }
 
@@ -255,7 +260,7 @@ class ParallelGripper {
     return eig.eigenvalues().minCoeff();
   }
 
-  void start_weld(rigid::RigidWorld& world, rigid::BodyId b, double dt) {
+  void start_weld(rigid::RigidWorld& world, rigid::BodyId b) {
     m_.held = b;
     m_.grasped_now = true;
     const Mat3 rg = world.orientation(body_).toRotationMatrix();
@@ -271,13 +276,16 @@ class ParallelGripper {
     const double lever2 = (xo - world.center_of_mass(body_)).squaredNorm();
     const double inv_m = m.inverse_mass + mg.inverse_mass + lever2 * mg.inverse_inertia.norm();
     const double inv_i = 1.0 / smallest_inertia(m) + 1.0 / smallest_inertia(mg);
-    m_.k = stable_stiffness(params_.weld_stiffness, 1.0 / inv_m, params_.max_omega_dt, dt);
-    m_.k_r = stable_stiffness(params_.weld_rotational_stiffness, 1.0 / inv_i, params_.max_omega_dt, dt);
-    m_.c = damping_for_ratio(params_.weld_damping_ratio, m_.k, 1.0 / inv_m);
-    m_.c_r = damping_for_ratio(params_.weld_damping_ratio, m_.k_r, 1.0 / inv_i);
+    m_.m_eff = 1.0 / inv_m;
+    m_.i_eff = 1.0 / inv_i;
+    m_.grasp_anchor_local = m_.anchor_local;
+    m_.k = params_.weld_stiffness;
+    m_.k_r = params_.weld_rotational_stiffness;
+    m_.c = damping_for_ratio(params_.weld_damping_ratio, m_.k, m_.m_eff);
+    m_.c_r = damping_for_ratio(params_.weld_damping_ratio, m_.k_r, m_.i_eff);
   }
 
-  void apply_weld(rigid::RigidWorld& world) {
+  void apply_weld(rigid::RigidWorld& world, double h) {
     const rigid::BodyId b = *m_.held;
     const Mat3 rg = world.orientation(body_).toRotationMatrix();
     const Vec3 xa = world.position(body_) + rg * m_.anchor_local;
@@ -285,17 +293,30 @@ class ParallelGripper {
     const Mat3 ra = rg * m_.rotation_local;
     const Mat3 ro = world.orientation(b).toRotationMatrix();
     const Vec3 dtheta = math::so3::log(Mat3(ro * ra.transpose()));  // lab axis
-    const Vec3 elastic = -m_.k * (xo - xa);
-    const Vec3 elastic_torque = -m_.k_r * dtheta;
-    m_.elastic_force = elastic.norm();
-    if (m_.elastic_force > params_.max_hold_force || elastic_torque.norm() > params_.max_hold_torque) {
-      m_.slipped = true;
-      release();
-      return;
-    }
     const Vec3 va = world.velocity_at_point(body_, xa);
-    m_.weld_force = elastic - m_.c * (world.linear_velocity(b) - va);
-    m_.weld_torque = elastic_torque - m_.c_r * (world.angular_velocity(b) - world.angular_velocity(body_));
+    const Vec3 dv = world.linear_velocity(b) - va;
+    const Vec3 dw = world.angular_velocity(b) - world.angular_velocity(body_);
+    // Implicit (backward Euler) spring-damper on the pair's relative motion: stable at any stiffness.
+    const double cf = m_.c + h * m_.k, cr = m_.c_r + h * m_.k_r;
+    Vec3 force = -(m_.k * (xo - xa) + cf * dv) / (1 + h * cf / m_.m_eff);
+    Vec3 torque = -(m_.k_r * dtheta + cr * dw) / (1 + h * cr / m_.i_eff);
+    // Friction: the grip carries at most max_hold_force / max_hold_torque; beyond, the object
+    // slides (the anchor follows it) and slips out once it has slid max_slide.
+    if (force.norm() > params_.max_hold_force) {
+      force *= params_.max_hold_force / force.norm();
+      m_.anchor_local = rg.transpose() * (xo - world.position(body_));
+      if (slide() > params_.max_slide) {
+        m_.slipped = true;
+        release();
+        return;
+      }
+    }
+    if (torque.norm() > params_.max_hold_torque) {
+      torque *= params_.max_hold_torque / torque.norm();
+      m_.rotation_local = rg.transpose() * ro;
+    }
+    m_.weld_force = force;
+    m_.weld_torque = torque;
     world.add_force_and_torque(b, m_.weld_force, m_.weld_torque);
     world.add_force_at_point(body_, -m_.weld_force, xo);
     world.add_torque(body_, -m_.weld_torque);
