@@ -68,11 +68,8 @@ class BatchedReachEnv {
       : pool_(threads) {
     if (batch_size < 1) manisoft::detail::fail("BatchedReachEnv: batch_size = ", batch_size, " must be >= 1");
     arms_.resize(std::size_t(batch_size));
-    auto build = [&](int part, int parts) {  // each arm builds its inverse statics: spread over the threads
-      for (std::size_t i = chunk_begin(part, parts); i < chunk_begin(part + 1, parts); ++i)
-        arms_[i] = std::make_unique<Env>(config, damping, action_settings);
-    };
-    pool_.run(build, active_threads());
+    // each arm builds its inverse statics: spread over the threads
+    for_each_arm([&](std::size_t i) { arms_[i] = std::make_unique<Env>(config, damping, action_settings); });
     rows_ = arms_[0]->action_space().rows();
     observed_ = int(control::make_arm_observation<double>(config.rod.n_elements, config.observe_stride).node_indices.size());
     const typename Env::Array3 zero = Env::Array3::Zero(rows_, 3);
@@ -121,10 +118,7 @@ class BatchedReachEnv {
           manisoft::detail::fail("BatchedReachEnv::step: arm ", i, ": action entry (", k / 3, ", ", k % 3, ") = ", actions[i * per_arm + k],
                                  " is not finite");
     }
-    auto job = [this, actions](int part, int parts) {
-      for (std::size_t i = chunk_begin(part, parts); i < chunk_begin(part + 1, parts); ++i) step_arm(i, actions);
-    };
-    pool_.run(job, active_threads());
+    for_each_arm([this, actions](std::size_t i) { step_arm(i, actions); });
   }
 
   std::span<const double> end_effector() const { return end_effector_; }
@@ -173,12 +167,19 @@ class BatchedReachEnv {
 
   std::size_t chunk_begin(int part, int parts) const { return arms_.size() * std::size_t(part) / std::size_t(parts); }
 
-  void reset_marked(std::span<const std::uint64_t> seeds) {
-    auto job = [this, seeds](int part, int parts) {
-      for (std::size_t i = chunk_begin(part, parts); i < chunk_begin(part + 1, parts); ++i)
-        if (do_reset_[i]) reset_arm(i, seeds[i]);
+  /// Calls f(i) for every arm i over the pool: each thread takes a contiguous chunk of arms.
+  template <typename F>
+  void for_each_arm(F&& f) {
+    auto job = [this, &f](int part, int parts) {
+      for (std::size_t i = chunk_begin(part, parts); i < chunk_begin(part + 1, parts); ++i) f(i);
     };
     pool_.run(job, active_threads());
+  }
+
+  void reset_marked(std::span<const std::uint64_t> seeds) {
+    for_each_arm([this, seeds](std::size_t i) {
+      if (do_reset_[i]) reset_arm(i, seeds[i]);
+    });
     started_ = true;
   }
 
@@ -221,12 +222,8 @@ class BatchedReachEnv {
   }
 
   static void write_pose(const math::Pose<double>& pose, double* out) {
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) out[r * 4 + c] = pose.rotation(r, c);
-      out[r * 4 + 3] = pose.translation(r);
-    }
-    out[12] = out[13] = out[14] = 0;
-    out[15] = 1;
+    Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> matrix(out);
+    matrix = pose.matrix();
   }
 
   void write_observation(std::size_t i, const control::Observation<double>& o) {
