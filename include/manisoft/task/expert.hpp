@@ -48,8 +48,10 @@
 // gripper touches anything else (the closed fingers on a bowl below: fingers_blocked) (a tall
 // one, height above tall_ratio x width, is lowered on until its support carries it, contact_depth
 // below, so it is not dropped onto its rim; the arm stops there, release_lift up, and opens once
-// its tip is slower than release_settle_speed), then up at retract_peak_speed until the
-// fingertips clear the object's top (after the last move too). A
+// its tip is slower than release_settle_speed), then, once the opening fingers clear the object
+// by release_clearance on each side (fingers still on it drag it along as the arm sways: a tall
+// one tips over), up at retract_peak_speed until the fingertips clear the object's top (after
+// the last move too). A
 // leg whose straight line would pass towards the inner edge of the arm's reach (arc_inset nearer
 // its base than its farther end) goes round an arc point about the base instead. A missed grasp
 // re-opens and retries the move from its approach (max_retries); so does, backing off along its
@@ -111,6 +113,7 @@ struct ExpertConfig {
   double release_settle_speed = 0.05;  ///< m/s: once the support carries a tall object, stop and open only when the arm's tip is slower (0: open at once)
   double tall_ratio = 1.2;          ///< an object is tall (release_settle_speed) above this height / width
   double release_lift = 0.0;        ///< m: the stop above where the arm is (release_settle_speed)
+  double release_clearance = 0.01;  ///< m: the retract waits until the opening fingers clear the released object by this much on each side (or are fully open)
   double contact_depth = 0.001;     ///< m: a tall object is lowered until its support carries it: its lower line ends this far below its support (deeper presses it on, and it rocks on its base after the release)
   double retract_peak_speed = 0.9;  ///< m/s: peak end-effector speed of the retract after a release
   double lower_peak_speed = 0.3;    ///< m/s: peak end-effector speed of the lower line
@@ -140,7 +143,7 @@ struct ExpertConfig {
                                   {"place_clearance", place_clearance}, {"retract_height", retract_height},
                                   {"finger_clearance", finger_clearance}, {"stack_finger_clearance", stack_finger_clearance},
                                   {"carry_grip_share", carry_grip_share}, {"release_settle_speed", release_settle_speed},
-                                  {"release_lift", release_lift}, {"contact_depth", contact_depth}, {"slow_lower", slow_lower},
+                                  {"release_lift", release_lift}, {"release_clearance", release_clearance}, {"contact_depth", contact_depth}, {"slow_lower", slow_lower},
                                   {"approach_tip_clearance", approach_tip_clearance}, {"carry_settle_speed", carry_settle_speed},
                                   {"tight_clearance", tight_clearance}, {"table_clearance", table_clearance},
                                   {"arm_clearance", arm_clearance}, {"held_clearance", held_clearance}, {"arc_inset", arc_inset}}) {
@@ -1079,6 +1082,7 @@ class Expert {
         }
         break;
       case ExpertPhase::open:
+        if (w.gripper().opening() && w.gripper().finger_width() < plan_.width + 2 * config_.release_clearance) break;
         // Up and away from the released object, also after the last move (fingers left
         // around it keep pushing it as the arm sways, and it never comes to rest).
         ++move_;
