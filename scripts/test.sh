@@ -10,6 +10,8 @@
 #      programs in one translation unit, manisoft_add_unrun_check in CMakeLists.txt), and the
 #      installed package is built against by a consumer project. clang, not g++, does these checks:
 #      it parses this code in a quarter of g++'s time.
+#      The libFuzzer targets of the file readers (tests/fuzz, MANISOFT_FUZZ) run 8 s each on their
+#      corpora (label fuzz).
 # Tests that instantiate the same templates share an executable built as one unity translation
 # unit (tests/CMakeLists.txt): every test of the world, the executor, the assets, the scenes, the
 # tasks and the recorded expert is one unit, so the world is compiled once, not once per group.
@@ -29,7 +31,7 @@ cmake --build "$root/build/gcc-release" -j"$jobs"
 
 echo "== clang++ ASan+UBSan build"
 cmake -S "$root" -B "$root/build/clang-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DMANISOFT_SANITIZE=ON -DMANISOFT_BUILD_EXAMPLES=ON -DMANISOFT_BUILD_BENCHMARKS=ON -DMANISOFT_HEADER_CHECK=ON -DMANISOFT_CHECK_ONLY=ON -DMANISOFT_ONE_PROGRAM_BINARY=ON
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DMANISOFT_SANITIZE=ON -DMANISOFT_FUZZ=ON -DMANISOFT_BUILD_EXAMPLES=ON -DMANISOFT_BUILD_BENCHMARKS=ON -DMANISOFT_HEADER_CHECK=ON -DMANISOFT_CHECK_ONLY=ON -DMANISOFT_ONE_PROGRAM_BINARY=ON
 cmake --build "$root/build/clang-asan" -j"$jobs"
 # The longest tests under the sanitizers (30-160 s each there, 25 times their g++ time: the
 # nested bowls' contact, the scene-validity samples, the placement band, the instruction matchers

@@ -593,6 +593,11 @@ TEST_CASE("malformed input: errors name the file and the line or element", "[imp
   const std::string bad_json = write("bad.json", "{\n  \"mass\": 1.0,\n  \"friction\": ,\n}\n");
   std::string msg = message([&] { import_asset(good, bad_json); });
   CHECK(msg.find("bad.json:3:") != std::string::npos);
+  // a number beyond the range of a double: refused as the file's error, not nlohmann's exception
+  // (tests/fuzz/corpus/sidecar/number_overflow.json)
+  msg = message([&] { manisoft::assets::parse_sidecar(R"({"density": 1e400})", "huge.json"); });
+  CHECK(msg.find("huge.json: cannot be read") != std::string::npos);
+  CHECK(msg.find("1e400") != std::string::npos);
   // wrong type: the element's JSON pointer
   const std::string wrong = write("wrong.json", R"({"grasps": [{"grasp": {"position": [0, 0, "x"]}}]})");
   msg = message([&] { import_asset(good, wrong); });

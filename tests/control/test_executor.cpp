@@ -499,6 +499,9 @@ TEST_CASE("malformed MLP weight files are refused with file and line", "[executo
       {"activation", "manisoft-mlp 1\nlayers 1\ninput 1\nlayer 1 swish\n1\n0\n", "unknown activation 'swish'"},
       {"truncated", "manisoft-mlp 1\nlayers 2\ninput 1\nlayer 1 linear\n1\n0\n", "unexpected end of file"},
       {"trailing", "manisoft-mlp 1\nlayers 1\ninput 1\nlayer 1 linear\n1\n0\n5\n", ":7:"},
+      // sizes the file does not hold (a 10^6 x 10^6 matrix: 8 TB): the end of the file is
+      // reported, nothing of that size is allocated (tests/fuzz/corpus/mlp_weights/huge_layer.txt)
+      {"huge_layer", "manisoft-mlp 1\nlayers 1\ninput 1000000\nlayer 1000000 relu\n", ":5: unexpected end of file, expected a weight row"},
   };
   for (const Case& c : cases) {
     const std::string path = write_file(std::string(c.name) + ".txt", c.text);

@@ -135,6 +135,26 @@ TEST_CASE("truncated and corrupted episode files are detected, naming the file",
   CHECK_THROWS_WITH(ds::read_episode(bad, 1), Catch::Contains("bad.hdf5: not a readable HDF5 file"));
 }
 
+TEST_CASE("a dataset declaring more values than its file stores is refused before they are allocated", "[dataset][input]") {
+  // /data/demo_0/actions declared 2^40 x 7 (56 TB of float64) in chunks never written: a 3 KB file
+  // (tests/fuzz/corpus/episode_file/huge_dims.hdf5 is the same file written by h5py)
+  const fs::path path = manisoft::test::scratch_dir("manisoft_dataset_huge_dims") / "huge_dims.hdf5";
+  {
+    const ds::h5::Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+    const ds::h5::Handle links(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
+    H5Pset_create_intermediate_group(links.get(), 1);
+    const hsize_t dims[2] = {hsize_t{1} << 40, 7}, chunk[2] = {256, 7};
+    const ds::h5::Handle space(H5Screate_simple(2, dims, nullptr), H5Sclose);
+    const ds::h5::Handle layout(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+    H5Pset_chunk(layout.get(), 2, chunk);
+    const ds::h5::Handle data(H5Dcreate2(file.get(), "/data/demo_0/actions", H5T_NATIVE_DOUBLE, space.get(), links.get(), layout.get(), H5P_DEFAULT),
+                              H5Dclose);
+    REQUIRE(data.valid());
+  }
+  CHECK_THROWS_WITH(ds::read_episode(path, 0),
+                    Catch::Contains("huge_dims.hdf5: /data/demo_0/actions: a dataset of 1099511627776 x 7 values of 8 bytes has only 0 bytes stored"));
+}
+
 TEST_CASE("64-bit FNV-1a gives the published test vectors", "[dataset]") {
   // Fowler, Noll, Vo: FNV-1a 64 of "", "a" and "foobar" (the reference test suite).
   const auto fnv = [](const std::string& s) {

@@ -302,6 +302,8 @@ inline Sidecar parse_sidecar(const std::string& text, const std::string& file, c
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     ::manisoft::detail::fail(file, ":", detail::line_column(text, e.byte), ": JSON syntax error: ", e.what());
+  } catch (const nlohmann::json::exception& e) {  // a number beyond the range of a double (1e400)
+    ::manisoft::detail::fail(file, ": cannot be read: ", e.what());
   }
   const detail::JsonReader r(file);
   r.object(j, "");

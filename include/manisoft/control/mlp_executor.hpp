@@ -107,13 +107,16 @@ class Mlp {
       const int size = reader.positive_int(t[1], "layer size");
       Layer layer;
       layer.activation = reader.activation(t[2]);
-      layer.weights.resize(size, previous);
+      // Storage grows with the rows read, so sizes the file does not back are never allocated
+      // ("input 1000000" and "layer 1000000" would be 8 TB).
+      std::vector<Scalar> weights;
       for (int i = 0; i < size; ++i) {
         t = reader.next("a weight row");
         if (static_cast<int>(t.size()) != previous)
           reader.fail("layer ", l + 1, " weight row ", i + 1, " has ", t.size(), " numbers, expected ", previous);
-        for (int j = 0; j < previous; ++j) layer.weights(i, j) = reader.number(t[j]);
+        for (int j = 0; j < previous; ++j) weights.push_back(reader.number(t[j]));
       }
+      layer.weights = Eigen::Map<const Matrix>(weights.data(), size, previous);
       t = reader.next("a bias row");
       if (static_cast<int>(t.size()) != size) reader.fail("layer ", l + 1, " bias has ", t.size(), " numbers, expected ", size);
       layer.bias.resize(size);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -200,10 +201,8 @@ class File {
     ScopedSilence silence;
     const Handle data = open_dataset(path);
     shape = dims_of(data, path);
-    hsize_t count = 1;
-    for (hsize_t s : shape) count *= s;
-    std::vector<T> values(count);
-    if (count > 0 && H5Dread(data.get(), native_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)
+    std::vector<T> values(stored_count(data, path, shape));
+    if (!values.empty() && H5Dread(data.get(), native_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)
       fail_at(name_, path, "reading the dataset failed (truncated or corrupted file?)");
     return values;
   }
@@ -339,6 +338,7 @@ class File {
     Handle space(H5Dget_space(data.get()), H5Sclose);
     hsize_t n = 0;
     H5Sget_simple_extent_dims(space.get(), &n, nullptr);
+    n = stored_count(data, path, {n});
     std::vector<char> packed(n * width + 1, '\0');
     if (n > 0 && H5Dread(data.get(), stored.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, packed.data()) < 0)
       fail_at(name_, path, "reading the string dataset failed");
@@ -366,6 +366,29 @@ class File {
     Handle data(H5Dopen2(id(), path.c_str(), H5P_DEFAULT), H5Dclose);
     if (!data.valid()) fail_at(name_, path, "cannot open the dataset (not a dataset, or the file is damaged)");
     return data;
+  }
+
+  /// The number of values of the dataset of `shape`, refused when the file cannot hold them: a
+  /// header of a few bytes can declare 2^40 rows whose chunks were never written (reading them
+  /// would allocate terabytes). Allowed: at most 1032 bytes of values per byte stored for the
+  /// dataset (deflate's largest ratio; unfiltered data is stored 1:1).
+  std::size_t stored_count(const Handle& data, const std::string& path, const std::vector<hsize_t>& shape) const {
+    Handle stored(H5Dget_type(data.get()), H5Tclose);
+    const hsize_t width = std::max<hsize_t>(1, H5Tget_size(stored.get()));
+    const hsize_t bytes_stored = H5Dget_storage_size(data.get());
+    constexpr hsize_t max_ratio = 1032;
+    const hsize_t limit = std::min<hsize_t>(bytes_stored, std::numeric_limits<hsize_t>::max() / max_ratio) * max_ratio / width;
+    hsize_t count = 1;
+    for (hsize_t n : shape) {
+      if (n != 0 && count > limit / n) {
+        std::string dims;
+        for (hsize_t d : shape) dims += (dims.empty() ? "" : " x ") + std::to_string(d);
+        fail_at(name_, path, "a dataset of ", dims, " values of ", width, " bytes has only ", bytes_stored,
+                " bytes stored (truncated or corrupted file?)");
+      }
+      count *= n;
+    }
+    return static_cast<std::size_t>(count);
   }
 
   std::vector<hsize_t> dims_of(const Handle& data, const std::string& path) const {

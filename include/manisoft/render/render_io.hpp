@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -47,8 +48,8 @@ inline std::vector<std::string> split_csv(const std::string& line) {
   return out;
 }
 
-/// Reads a trace; throws manisoft::Error for a missing file, a row of the wrong width or a
-/// non-numeric cell (naming the line).
+/// Reads a trace; throws manisoft::Error for a missing file, a row of the wrong width or a cell
+/// that is not a finite number (naming the line and the column).
 inline Trace read_trace(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) manisoft::detail::fail("trace ", path.string(), ": cannot open the file");
@@ -72,8 +73,8 @@ inline Trace read_trace(const std::filesystem::path& path) {
     for (std::size_t i = 0; i < cells.size(); ++i) {
       char* end = nullptr;
       row[i] = std::strtod(cells[i].c_str(), &end);
-      if (end == cells[i].c_str() || *end != '\0') {
-        manisoft::detail::fail("trace ", path.string(), " line ", line_number, ": column '", t.columns[i], "' = '", cells[i], "' is not a number");
+      if (end == cells[i].c_str() || *end != '\0' || !std::isfinite(row[i])) {
+        manisoft::detail::fail("trace ", path.string(), " line ", line_number, ": column '", t.columns[i], "' = '", cells[i], "' is not a finite number");
       }
     }
     t.rows.push_back(std::move(row));
@@ -124,7 +125,10 @@ inline FrameState frame_from_trace(const tabletop::TabletopScene& scene, const T
   f.rod.directors.resize(0, 9);
   for (int i = 0; i < nodes; ++i) {
     const std::string p = "node" + std::to_string(i);
-    f.rod.nodes.row(i) << t.at(row, p + "_x"), t.at(row, p + "_y"), t.at(row, p + "_z");
+    // read before the comma initializer: a missing column throws, and an initializer left
+    // incomplete by an exception asserts in its destructor
+    const double x = t.at(row, p + "_x"), y = t.at(row, p + "_y"), z = t.at(row, p + "_z");
+    f.rod.nodes.row(i) << x, y, z;
   }
   tabletop::set_gripper(scene, f, pose_from(t, row, "gripper"), t.at(row, "finger_width"));
   // every instance whose name's first word has pose columns (all parts of a multi-part asset)
