@@ -138,8 +138,8 @@ class Sequence(Space):
     (the objects' poses: as many as the scene has). sample() draws k from a geometric law."""
 
     def __init__(self, space, seed=None):
-        super().__init__(None, space.dtype, seed)
         self.feature_space = space
+        super().__init__(None, space.dtype, seed)
 
     def seed(self, seed=None):
         result = super().seed(seed)
