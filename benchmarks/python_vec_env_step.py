@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Reach control steps a minute from Python: a Python loop over B single environments
 (manisoft.make_env("reach")) against one vector environment (manisoft.make_vec_env("reach", B,
-num_threads)) for B = 1, 8, 64, in the same run. Every arm takes a fixed mild action (a few N m
+num_threads), 2 and 1 threads) for B = 1, 8, 64, in the same run. Every arm takes a fixed mild action (a few N m
 per element, as bench_env's BatchedReachEnv benchmark) and no episode ends while timed (the
 horizon is the default 1500; --steps < 1500). Prints min and median over --repeats of the wall
 time of --steps batch steps, as control steps a minute (arms x steps / wall time).
@@ -53,15 +53,16 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--steps", type=int, default=100, help="batch steps a repeat (< 1500: no episode ends)")
-    p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--threads", type=int, nargs="+", default=[2, 1], help="make_vec_env's num_threads, each measured")
     p.add_argument("--arms", type=int, nargs="+", default=[1, 8, 64])
     args = p.parse_args()
     for arms in args.arms:
         envs = [manisoft.make_env("reach", seed=i) for i in range(arms)]
         report("Python loop, make_env", arms, 1, args.steps, [time_loop(envs, args.steps) for _ in range(args.repeats)])
-        vec = manisoft.make_vec_env("reach", arms, num_threads=args.threads, seed=0)
-        report("make_vec_env", arms, args.threads, args.steps, [time_vec(vec, args.steps) for _ in range(args.repeats)])
-        vec.close()
+        for threads in args.threads:
+            vec = manisoft.make_vec_env("reach", arms, num_threads=threads, seed=0)
+            report("make_vec_env", arms, threads, args.steps, [time_vec(vec, args.steps) for _ in range(args.repeats)])
+            vec.close()
         for env in envs:
             env.close()
 
