@@ -66,7 +66,7 @@ def collect(args):
                   f"{len(images)} samples, {time.perf_counter() - t0:.0f} s", flush=True)
     space = envs["clean"].action_space
     tmp = args.out + ".tmp.npz"
-    np.savez_compressed(tmp, images=np.asarray(images), texts=np.asarray(texts), chunks=np.asarray(chunks), high=space["high"],
+    np.savez_compressed(tmp, images=np.asarray(images), texts=np.asarray(texts), chunks=np.asarray(chunks), high=space.high,
                         episodes=np.asarray([f"{t} {s} {i} {int(ok)} {n}" for t, s, i, ok, n in episodes]))
     os.replace(tmp, args.out)
     ok = sum(e[3] for e in episodes)

@@ -225,7 +225,7 @@ class RandomPolicy:
     result does not depend on which worker runs it."""
 
     def __init__(self, space, seed):
-        self.low, self.high, self.seed = space["low"], space["high"], seed
+        self.low, self.high, self.seed = space.low, space.high, seed
         self.rng = None
 
     def start(self, task, setting, index):
@@ -338,7 +338,7 @@ class Worker:
         t0 = time.perf_counter()
         obs, info = env.reset(seed=self.args.seed, options={"index": index, "split": "eval", "instruction": instruction,
                                                           "instruction_index": number // 2})
-        size = env.action_space["shape"][0]
+        size = env.action_space.shape[0]
         actions, failure, detail, hung = [], info["failure"], "", False
         chunk, used, started = None, 0, True
         try:

@@ -9,10 +9,11 @@
 //   obs, info = env.reset(options={"index": 3})          # obs["image"], obs["instruction"]
 //   obs, reward, terminated, truncated, info = env.step(env.expert_action())
 //   reach = manisoft.make_env("reach", target_set="table", seed=0)
+//   vec = manisoft.make_vec_env("reach", 64)             # B arms stepped together (manisoft_vec.py)
 //
 // Task actions: float vectors of 3n + 1 (torques row by row, then S); reach actions: (n x 3)
 // torques. Other real dtypes are converted; torques are clamped to the actuation limits
-// (action_space["low"/"high"]). Bad input (shape, dtype, NaN, a call after close) raises
+// (action_space.low / .high; the spaces are made by manisoft_vec.py from the specs here). Bad input (shape, dtype, NaN, a call after close) raises
 // ValueError / RuntimeError with the library's message; the GIL is released while the simulation
 // steps and while a frame renders. Lists and tuples are accepted as actions (numpy.asarray). An
 // environment serves one call at a time from any thread, and once it renders only the thread that
@@ -25,18 +26,30 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
+#include <type_traits>
+#include <vector>
 
 #include "manisoft/control/model_executor.hpp"
+#include "manisoft/env/batched_reach_env.hpp"
 #include "manisoft/env/reach_env.hpp"
 #include "task_environment.hpp"
 
 namespace py = pybind11;
 
+namespace manisoft_py {
+/// Runs the module's Python half (manisoft_vec.py: spaces, make_vec_env) in the module (python_side.cpp).
+void add_python_side(py::module_& m);
+}  // namespace manisoft_py
+
 namespace {
 
 using Env = manisoft::env::ReachEnv<>;  // PyElastica's analytical damping, element torques
 using Array3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+using Seeds = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>;
+using Flags = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
+using Actions = py::array_t<double, py::array::c_style | py::array::forcecast>;
 const int task_horizon = manisoft::task::TaskEnvConfig{}.horizon;  ///< the tasks' T
 
 py::array_t<double> to_numpy(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>& m) {
@@ -47,12 +60,46 @@ py::array_t<double> to_numpy(const Eigen::Ref<const Eigen::Matrix<double, Eigen:
   return out;
 }
 
+manisoft::env::ReachEnvConfig reach_config(const std::string& target_set, int horizon) {
+  manisoft::env::ReachEnvConfig config;
+  config.target_set = manisoft::env::parse_target_set(target_set);
+  if (horizon < 1) manisoft::detail::fail("horizon = ", horizon, " must be >= 1");
+  config.horizon = horizon;
+  return config;
+}
+
 py::array_t<double> pose_matrix(const manisoft::math::Pose<double>& pose) { return to_numpy(pose.matrix()); }
+
+/// The reach environment's action and observation spaces as plain values (manisoft_vec.py makes spaces of them).
+py::dict reach_action_spec(const Env& env) {
+  const auto& limits = env.config().limits;
+  Array3 high(env.n_elements(), 3);
+  for (int k = 0; k < env.n_elements(); ++k)
+    for (int c = 0; c < 3; ++c) high(k, c) = k == 0 ? 0.0 : limits.limit(c);
+  py::dict d;
+  d["shape"] = py::make_tuple(env.n_elements(), 3);
+  d["dtype"] = "float64";
+  d["low"] = to_numpy(-high);
+  d["high"] = to_numpy(high);
+  return d;
+}
+
+py::dict reach_observation_spec(const Env& env) {
+  const auto nodes = static_cast<int>(env.config().rod.n_elements / env.config().observe_stride + 1 +
+                                      (env.config().rod.n_elements % env.config().observe_stride ? 1 : 0));
+  py::dict d;
+  d["end_effector"] = py::make_tuple(py::make_tuple(4, 4), "float64");
+  d["target"] = py::make_tuple(py::make_tuple(4, 4), "float64");
+  d["node_positions"] = py::make_tuple(py::make_tuple(nodes, 3), "float64");
+  d["node_velocities"] = py::make_tuple(py::make_tuple(nodes, 3), "float64");
+  d["time"] = py::make_tuple(py::make_tuple(), "float64");
+  return d;
+}
 
 class ReachEnvironment {
  public:
   ReachEnvironment(const std::string& target_set, std::uint64_t seed, int horizon)
-      : env_(make_config(target_set, horizon), manisoft::rod::damping::AnalyticalLinear<double>(0.1)),
+      : env_(reach_config(target_set, horizon), manisoft::rod::damping::AnalyticalLinear<double>(0.1)),
         expert_(env_.nominal_model(), env_.config().limits),
         next_seed_(seed),
         action_(Array3::Zero(env_.n_elements(), 3)) {}
@@ -115,30 +162,8 @@ class ReachEnvironment {
     return to_numpy(action);
   }
 
-  py::dict action_space() const {
-    const auto& limits = env_.config().limits;
-    Array3 high(env_.n_elements(), 3);
-    for (int k = 0; k < env_.n_elements(); ++k)
-      for (int c = 0; c < 3; ++c) high(k, c) = k == 0 ? 0.0 : limits.limit(c);
-    py::dict d;
-    d["shape"] = py::make_tuple(env_.n_elements(), 3);
-    d["dtype"] = "float64";
-    d["low"] = to_numpy(-high);
-    d["high"] = to_numpy(high);
-    return d;
-  }
-
-  py::dict observation_space() const {
-    const auto nodes = static_cast<int>(env_.config().rod.n_elements / env_.config().observe_stride + 1 +
-                                        (env_.config().rod.n_elements % env_.config().observe_stride ? 1 : 0));
-    py::dict d;
-    d["end_effector"] = py::make_tuple(py::make_tuple(4, 4), "float64");
-    d["target"] = py::make_tuple(py::make_tuple(4, 4), "float64");
-    d["node_positions"] = py::make_tuple(py::make_tuple(nodes, 3), "float64");
-    d["node_velocities"] = py::make_tuple(py::make_tuple(nodes, 3), "float64");
-    d["time"] = py::make_tuple(py::make_tuple(), "float64");
-    return d;
-  }
+  py::dict action_space() const { return reach_action_spec(env_); }
+  py::dict observation_space() const { return reach_observation_spec(env_); }
 
   void close() {
     const auto entered = threads_.enter("close", true);
@@ -147,14 +172,6 @@ class ReachEnvironment {
   int horizon() const { return env_.config().horizon; }
 
  private:
-  static manisoft::env::ReachEnvConfig make_config(const std::string& target_set, int horizon) {
-    manisoft::env::ReachEnvConfig config;
-    config.target_set = manisoft::env::parse_target_set(target_set);
-    if (horizon < 1) manisoft::detail::fail("horizon = ", horizon, " must be >= 1");
-    config.horizon = horizon;
-    return config;
-  }
-
   void check_open() const {
     if (closed_) throw std::runtime_error("the environment is closed");
   }
@@ -194,6 +211,73 @@ class ReachEnvironment {
   const manisoft::control::Observation<double>* observation_ = nullptr;
   bool started_ = false;
   bool closed_ = false;
+  manisoft_py::ThreadUse threads_;
+};
+
+/// The batched reach environment's compiled half (env/batched_reach_env.hpp); manisoft.make_vec_env
+/// wraps it with Gymnasium's vector API (manisoft_vec.py). Its arrays are numpy views of the batch's
+/// own buffers, kept alive by the object and overwritten by every reset and step.
+class ReachBatch {
+ public:
+  ReachBatch(int num_envs, int threads, const std::string& target_set, int horizon)
+      : batch_(num_envs, threads, reach_config(target_set, horizon), manisoft::rod::damping::AnalyticalLinear<double>(0.1)) {}
+
+  /// Resets the arms with mask[i] (every arm when mask is None), arm i with seeds[i].
+  void reset(const Seeds& seeds, const std::optional<Flags>& mask) {
+    const auto entered = threads_.enter("reset");
+    py::gil_scoped_release release;
+    if (mask)
+      batch_.reset(std::span<const std::uint8_t>(mask->data(), std::size_t(mask->size())), std::span<const std::uint64_t>(seeds.data(), std::size_t(seeds.size())));
+    else
+      batch_.reset(std::span<const std::uint64_t>(seeds.data(), std::size_t(seeds.size())));
+  }
+
+  /// One step of every arm: actions hold num_envs x rows x 3 float64 values (C order).
+  void step(const Actions& actions) {
+    const auto entered = threads_.enter("step");
+    py::gil_scoped_release release;
+    batch_.step(std::span<const double>(actions.data(), std::size_t(actions.size())));
+  }
+
+  /// The batch's arrays by name (views; the owner keeps the batch alive).
+  static py::dict arrays(const py::object& owner) {
+    const auto& b = owner.cast<const ReachBatch&>().batch_;
+    const py::ssize_t n = b.batch_size(), m = b.observed_nodes();
+    py::dict d;
+    d["end_effector"] = view(b.end_effector(), {n, 4, 4}, owner);
+    d["target"] = view(b.target(), {n, 4, 4}, owner);
+    d["node_positions"] = view(b.node_positions(), {n, m, 3}, owner);
+    d["node_velocities"] = view(b.node_velocities(), {n, m, 3}, owner);
+    d["rewards"] = view(b.rewards(), {n}, owner);
+    d["terminated"] = view(b.terminated(), {n}, owner);
+    d["truncated"] = view(b.truncated(), {n}, owner);
+    d["success"] = view(b.success(), {n}, owner);
+    d["steps"] = view(b.steps(), {n}, owner);
+    d["position_error"] = view(b.position_error(), {n}, owner);
+    d["rotation_error"] = view(b.rotation_error(), {n}, owner);
+    d["clipped"] = view(b.clipped(), {n}, owner);
+    d["max_node_speed"] = view(b.max_node_speed(), {n}, owner);
+    d["seeds"] = view(b.seeds(), {n}, owner);
+    return d;
+  }
+
+  int num_envs() const { return batch_.batch_size(); }
+  int threads() const { return batch_.threads(); }
+  int action_rows() const { return batch_.action_rows(); }
+  py::dict action_space() const { return reach_action_spec(batch_.arm(0)); }
+  py::dict observation_space() const { return reach_observation_spec(batch_.arm(0)); }
+
+ private:
+  /// A read-only view of a batch buffer (flags: numpy bool over the same 0 / 1 bytes).
+  template <typename T>
+  static py::array view(std::span<const T> data, std::vector<py::ssize_t> shape, const py::object& owner) {
+    const py::dtype type = std::is_same_v<T, std::uint8_t> ? py::dtype::of<bool>() : py::dtype::of<T>();
+    py::array out(type, std::move(shape), {}, data.data(), owner);
+    py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+    return out;
+  }
+
+  manisoft::env::BatchedReachEnv<> batch_;
   manisoft_py::ThreadUse threads_;
 };
 
@@ -250,9 +334,19 @@ PYBIND11_MODULE(manisoft, m) {
            "One control step (7 x 0.2 ms): (observation, reward, terminated, truncated, info)")
       .def("expert_action", &ReachEnvironment::expert_action, "The model-based executor's action now")
       .def("close", &ReachEnvironment::close)
-      .def_property_readonly("action_space", &ReachEnvironment::action_space)
-      .def_property_readonly("observation_space", &ReachEnvironment::observation_space)
+      .def("_action_space_spec", &ReachEnvironment::action_space)            // manisoft_vec.py makes the spaces of these
+      .def("_observation_space_spec", &ReachEnvironment::observation_space)
       .def_property_readonly("horizon", &ReachEnvironment::horizon);
+  py::class_<ReachBatch>(m, "_ReachBatch", "B reach environments stepped together (use manisoft.make_vec_env)")
+      .def(py::init<int, int, const std::string&, int>(), py::arg("num_envs"), py::arg("threads"), py::arg("target_set"), py::arg("horizon"))
+      .def("reset", &ReachBatch::reset, py::arg("seeds"), py::arg("mask") = py::none())
+      .def("step", &ReachBatch::step, py::arg("actions"))
+      .def("arrays", [](const py::object& self) { return ReachBatch::arrays(self); })
+      .def_property_readonly("num_envs", &ReachBatch::num_envs)
+      .def_property_readonly("threads", &ReachBatch::threads)
+      .def_property_readonly("action_rows", &ReachBatch::action_rows)
+      .def("_action_space_spec", &ReachBatch::action_space)
+      .def("_observation_space_spec", &ReachBatch::observation_space);
   using manisoft_py::TaskEnvironment;
   py::class_<TaskEnvironment>(m, "TaskEnv",
                               "A ManiSoft task (COLL, ALN, STK, ARR): instruction and camera image in, torques and gripper state out (paper section 3.2)")
@@ -266,8 +360,8 @@ PYBIND11_MODULE(manisoft, m) {
       .def("close", &TaskEnvironment::close)
       .def("scene_json", &TaskEnvironment::scene_json, "The episode's scene (manisoft.scene/1 JSON)")
       .def_property_readonly("expert_phase", &TaskEnvironment::expert_phase)
-      .def_property_readonly("action_space", &TaskEnvironment::action_space)
-      .def_property_readonly("observation_space", &TaskEnvironment::observation_space)
+      .def("_action_space_spec", &TaskEnvironment::action_space)
+      .def("_observation_space_spec", &TaskEnvironment::observation_space)
       .def_property_readonly("horizon", &TaskEnvironment::horizon)
       .def_property_readonly("n_elements", &TaskEnvironment::n_elements);
   m.def(
@@ -311,6 +405,7 @@ PYBIND11_MODULE(manisoft, m) {
       "The benchmark's tasks in order: [{'name', 'summary', 'conditions', 'by_category'}] (success: every condition holds; "
       "by_category: evaluation plans and tables per target-object category)");
   m.attr("HORIZON") = task_horizon;
+  manisoft_py::add_python_side(m);
   m.attr("CONTROL_DT") = manisoft::task::TaskEnvConfig{}.dt * manisoft::task::TaskEnvConfig{}.substeps;
   m.def(
       "target_object",

@@ -13,17 +13,23 @@ class ReachEnvTest(unittest.TestCase):
     def test_spaces_and_reset(self):
         env = manisoft.make_env("reach", target_set="table", seed=1)
         space = env.action_space
-        self.assertEqual(space["shape"], (20, 3))
-        high = space["high"]
+        self.assertIsInstance(space, manisoft.Box)
+        self.assertEqual((space.shape, space.dtype), ((20, 3), np.float64))
+        high = space.high
         # Element 0 takes no torque; bend limits 150 N m, twist 75 N m (paper's actuation limits).
         np.testing.assert_array_equal(high[0], [0, 0, 0])
         np.testing.assert_array_equal(high[1:], np.tile([150.0, 150.0, 75.0], (19, 1)))
-        np.testing.assert_array_equal(space["low"], -high)
+        np.testing.assert_array_equal(space.low, -high)
         obs, info = env.reset(seed=3)
-        for key, (shape, dtype) in env.observation_space.items():
+        self.assertEqual(list(env.observation_space.keys()), ["end_effector", "target", "node_positions", "node_velocities", "time"])
+        for key, space in env.observation_space.items():
             value = np.asarray(obs[key])
-            self.assertEqual(value.shape, tuple(shape), key)
-            self.assertEqual(value.dtype, np.dtype(dtype), key)
+            self.assertEqual(value.shape, space.shape, key)
+            self.assertEqual(value.dtype, space.dtype, key)
+            self.assertTrue((space.low == -np.inf).all() and (space.high == np.inf).all(), key)  # unbounded
+        self.assertEqual(env.observation_space["node_positions"].shape, (11, 3))  # every 2nd node of 20 elements and the tip
+        self.assertTrue(env.observation_space.contains(obs))
+        self.assertIs(env.action_space, env.action_space)  # one object: its seed holds
         # The arm starts straight along +x from its base at (-0.05, 0, 1.5): the tip node 1 m on.
         np.testing.assert_allclose(obs["node_positions"][0], [-0.05, 0, 1.5], atol=1e-12)
         np.testing.assert_allclose(obs["node_positions"][-1], [0.95, 0, 1.5], atol=1e-9)

@@ -26,25 +26,33 @@ class TaskEnvTest(unittest.TestCase):
         space = env.action_space
         n = env.n_elements
         self.assertEqual(n, 20)
-        self.assertEqual(space["shape"], (3 * n + 1,))
-        high = space["high"]
+        self.assertIsInstance(space, manisoft.Box)
+        self.assertEqual((space.shape, space.dtype), ((3 * n + 1,), np.float64))
+        high = space.high
         # Element 0 is the clamped base (no torque); bend limits 150 N m, twist 75 N m; S in [0, 1].
         np.testing.assert_array_equal(high[:3], [0, 0, 0])
         np.testing.assert_array_equal(high[3:-1], np.tile([150.0, 150.0, 75.0], n - 1))
-        np.testing.assert_array_equal(space["low"][:-1], -high[:-1])
-        self.assertEqual((space["low"][-1], high[-1]), (0.0, 1.0))
+        np.testing.assert_array_equal(space.low[:-1], -high[:-1])
+        self.assertEqual((space.low[-1], high[-1]), (0.0, 1.0))
         obs, info = env.reset(options={"index": 3})
         scene = json.loads(env.scene_json())
         self.assertEqual(obs["instruction"], scene["instruction"])
         self.assertEqual((info["task"], info["setting"], info["index"], info["steps"]), ("COLL", "clean", 3, 0))
-        for key, (shape, dtype) in env.observation_space.items():
-            if key == "instruction":
-                self.assertIsInstance(obs[key], str)
-                continue
-            value = np.asarray(obs[key])
-            expected = tuple(len(scene["objects"]) if s == -1 else s for s in shape)
-            self.assertEqual(value.shape, expected, key)
-            self.assertEqual(value.dtype, np.dtype(dtype), key)
+        spaces = env.observation_space
+        self.assertIsInstance(spaces["instruction"], manisoft.Text)
+        self.assertIsInstance(obs["instruction"], str)
+        image = spaces["image"]
+        self.assertEqual((image.shape, image.dtype, image.low.min(), image.high.max()), ((80, 96, 3), np.uint8, 0, 255))
+        poses = spaces["object_poses"]  # as many 4 x 4 poses as the scene has objects
+        self.assertIsInstance(poses, manisoft.Sequence)
+        self.assertEqual(poses.feature_space.shape, (4, 4))
+        self.assertEqual(np.asarray(obs["object_poses"]).shape, (len(scene["objects"]), 4, 4))
+        for key in ("end_effector", "gripper_pose", "rod_nodes"):
+            self.assertEqual((obs[key].shape, obs[key].dtype), (spaces[key].shape, spaces[key].dtype), key)
+        # every entry, scalars included, lies in its space
+        for key, space in spaces.items():
+            self.assertTrue(space.contains(obs[key]), key)
+        self.assertTrue(spaces.contains(obs))
         self.assertEqual(obs["image"].shape, (80, 96, 3))
         # The arm is clamped at its mount: node 0 at the scene's base position.
         np.testing.assert_allclose(obs["rod_nodes"][0], scene["arm_mount"]["base_position"], atol=1e-9)
