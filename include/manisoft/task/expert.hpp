@@ -48,9 +48,9 @@
 // gripper touches anything else (the closed fingers on a bowl below: fingers_blocked) (a tall
 // one, height above tall_ratio x width, is lowered on until its support carries it, contact_depth
 // below, so it is not dropped onto its rim; the arm stops there, release_lift up, and opens once
-// its tip is slower than release_settle_speed), then, once the opening fingers clear the object
-// by release_clearance on each side (fingers still on it drag it along as the arm sways: a tall
-// one tips over), up at retract_peak_speed until the fingertips clear the object's top (after
+// its tip is slower than release_settle_speed), then (a tall one: once the opening fingers clear
+// it by release_clearance on each side; fingers still on it drag it along as the arm sways, and
+// it tips over) up at retract_peak_speed until the fingertips clear the object's top (after
 // the last move too). A
 // leg whose straight line would pass towards the inner edge of the arm's reach (arc_inset nearer
 // its base than its farther end) goes round an arc point about the base instead. A missed grasp
@@ -113,7 +113,7 @@ struct ExpertConfig {
   double release_settle_speed = 0.05;  ///< m/s: once the support carries a tall object, stop and open only when the arm's tip is slower (0: open at once)
   double tall_ratio = 1.2;          ///< an object is tall (release_settle_speed) above this height / width
   double release_lift = 0.0;        ///< m: the stop above where the arm is (release_settle_speed)
-  double release_clearance = 0.01;  ///< m: the retract waits until the opening fingers clear the released object by this much on each side (or are fully open)
+  double release_clearance = 0.01;  ///< m: the retract from a tall object waits until the opening fingers clear it by this much on each side (or are fully open)
   double contact_depth = 0.001;     ///< m: a tall object is lowered until its support carries it: its lower line ends this far below its support (deeper presses it on, and it rocks on its base after the release)
   double retract_peak_speed = 0.9;  ///< m/s: peak end-effector speed of the retract after a release
   double lower_peak_speed = 0.3;    ///< m/s: peak end-effector speed of the lower line
@@ -1082,7 +1082,7 @@ class Expert {
         }
         break;
       case ExpertPhase::open:
-        if (w.gripper().opening() && w.gripper().finger_width() < plan_.width + 2 * config_.release_clearance) break;
+        if (is_tall(plan_.object) && w.gripper().opening() && w.gripper().finger_width() < plan_.width + 2 * config_.release_clearance) break;
         // Up and away from the released object, also after the last move (fingers left
         // around it keep pushing it as the arm sways, and it never comes to rest).
         ++move_;
