@@ -516,11 +516,11 @@ TEST_CASE("the arm leaves a released tall object only once the opening fingers c
     r.success = e.info().success;
     return r;
   };
-  const double clearance = manisoft::task::ExpertConfig{}.release_clearance;
-  const auto& gripper = e.world().gripper().parameters();
-  const double step_opening = gripper.open_width / gripper.stroke_time * e.control_dt();
   const Release bottle = release(2);  // ALN clean 2: a bottle (tall)
   REQUIRE(bottle.object.rfind("bottle/", 0) == 0);
+  const double clearance = manisoft::task::ExpertConfig{}.release_clearance;
+  const auto gripper = e.world().gripper().parameters();  // the world exists once reset
+  const double step_opening = gripper.open_width / gripper.stroke_time * e.control_dt();
   CAPTURE(bottle.held_gap, bottle.gap_at_retract, bottle.open_steps, bottle.rise_while_open, step_opening);
   REQUIRE(bottle.held_gap > 0);
   CHECK(bottle.gap_at_retract >= std::min(bottle.held_gap + 2 * clearance, gripper.open_width) - step_opening);
