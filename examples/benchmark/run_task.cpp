@@ -115,6 +115,7 @@ int main(int argc, char** argv) {
     task::Expert expert(env, expert_config);
     const std::clock_t c1 = std::clock();
     env.reset(spec);
+    if (!scene_file.empty()) task::require_a_task(env, scene_file);
     expert.reset();
     if (!quiet) {
       std::printf("%s %s scene %llu (seed %llu): %zu objects, %zu obstacles\n", std::string(scene::to_string(spec.task)).c_str(),

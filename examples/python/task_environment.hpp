@@ -250,6 +250,9 @@ class TaskEnvironment {
       if (scene_json) {  // checked as a sampled scene is, before anything changes
         ms::scene::SceneSpec given = ms::scene::parse_scene(*scene_json, "reset(options['scene'])");
         ms::scene::require_valid(given, sampler_.validator(), "reset(options['scene'])");
+        ms::task::TaskEnv probe(sampler_.library(), env_.config());  // a goal met at reset is refused on a copy
+        probe.reset(given);
+        ms::task::require_a_task(probe, "reset(options['scene'])");
         spec_ = std::move(given);
       } else {
         spec_ = sampler_.sample(q);

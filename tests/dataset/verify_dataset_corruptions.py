@@ -8,7 +8,8 @@ and verify_dataset must exit 1 with the expected words (file, dataset or attribu
 An action edited within the limits and re-signed with a digest computed here from the documented
 byte stream (include/manisoft/dataset/episode_digest.hpp) passes the checks but not --replay, which
 names the step after it. A resume with other arguments is refused naming each differing flag with
-both values, and changes no file.
+both values, and changes no file. Every case is a row of docs/bad-inputs.md's section on dataset
+files (tests/bad_input_table.py).
 
 Usage: verify_dataset_corruptions.py GENERATE_DATASET VERIFY_DATASET
 """
@@ -22,6 +23,9 @@ import tempfile
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from bad_input_table import Section, cell  # noqa: E402
 
 GENERATE, VERIFY = sys.argv[1], sys.argv[2]
 ARGS = ["--tasks", "ALN", "--clean", "1", "--randomized", "1", "--seed", "4"]
@@ -90,6 +94,16 @@ with h5py.File(os.path.join(base, "episodes", "demo_0.hdf5"), "r") as f:
     edit_value = g["actions"][EDIT_STEP, 3 * 4 + 1]
 
 failures = []
+TABLE = Section("Dataset files", """
+`verify_dataset DIR` checks every file of a dataset that `generate_dataset` wrote: the schema (each
+dataset and attribute, shapes, dtypes, value ranges), the scene JSON, the index and its splits, and
+each episode's content digest; `--replay` re-simulates the episodes and names the first differing
+step. The dataset is two ALN episodes (`generate_dataset --tasks ALN --clean 1 --randomized 1
+--seed 4`), corrupted as the first column says (with h5py or in the file's bytes). A resume
+(`generate_dataset ... --resume`) with other arguments than the run that wrote the dataset is
+refused naming each differing flag, and changes no file. Test `verify_dataset_corruptions`
+(`tests/dataset/verify_dataset_corruptions.py`).
+""", ["corruption", "command", "exit", "message"])
 code, text = verify(base, "--replay")
 if code != 0 or "OK: 2 episodes" not in text or "2 episodes replayed bit for bit" not in text:
     failures.append(f"the generated dataset: exit {code}: {text}")
@@ -289,7 +303,9 @@ for name, corrupt, expected, extra in CASES:
     shutil.copytree(base, d)
     corrupt(d)
     code, text = verify(d, *extra)
-    rows.append(f"  {name}: exit {code}: {text.splitlines()[-1] if text else ''}")
+    last = text.splitlines()[-1] if text else ""
+    rows.append(f"  {name}: exit {code}: {last}")
+    TABLE.add(name.replace("_", " "), "`verify_dataset DIR" + "".join(" " + e for e in extra) + "`", str(code), cell(last, work))
     if code != 1 or expected not in text:
         failures.append(f"{name}: exit {code}, expected exit 1 with '{expected}', got: {text}")
     shutil.rmtree(d)
@@ -309,6 +325,8 @@ for changed, words in [(["--seed", "6"], ["--seed is 6 here, 4 there"]),
             args += [flag, value]
     p = subprocess.run([GENERATE, *args, "--out", base, "--resume"], capture_output=True, text=True)
     rows.append(f"  resume {' '.join(changed)}: exit {p.returncode}: {p.stderr.strip()}")
+    TABLE.add("resumed with other arguments", f"`generate_dataset ... {' '.join(changed)} --resume`", str(p.returncode),
+              cell(p.stderr.strip().splitlines()[0] if p.stderr.strip() else "", work))
     if p.returncode != 1 or not all(w in p.stderr for w in words):
         failures.append(f"resume with {changed}: exit {p.returncode}, expected 1 naming {words}: {p.stderr}")
 p = subprocess.run([GENERATE, *ARGS, "--out", base, "--resume"], capture_output=True, text=True)
@@ -318,6 +336,7 @@ if tree_hash(base) != before:
     failures.append("a refused (or empty) resume changed files in the dataset")
 
 print("\n".join(rows))
+TABLE.finish(failures)
 shutil.rmtree(work)
 if failures:
     print("FAIL:\n" + "\n".join(failures))

@@ -2,17 +2,13 @@
 non-zero exit status and a message that names the flag and the value, the key and the file, or
 the file that could not be written, and leaves no output that looks complete.
 
-    test_bad_inputs.py BIN_DIR SCRATCH_DIR [--write-table]
+    test_bad_inputs.py BIN_DIR SCRATCH_DIR
 
 BIN_DIR holds the example programs. rod_sim, reach_eval, scene_sample and render_scene are
 required (the tests build them); run_task, generate_dataset and pick_place_eval are checked when
 they are there (builds that only check them for warnings do not make them). Every case is listed
-as it runs: program, input, exit status and the message's first line.
-
-docs/bad-inputs.md holds the table of these cases as they run (the scratch folder written DIR):
-every row of a program built here must be in it and every row of it that names such a program
-must come out of this run, so the table cannot go stale. --write-table rewrites it from this run
-(keeping the rows of programs not built here).
+as it runs: program, input, exit status and the message's first line, and is a row of
+docs/bad-inputs.md (tests/bad_input_table.py): the sections of flags, scene files and traces.
 """
 import json
 import os
@@ -21,11 +17,37 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from bad_input_table import Section, cell  # noqa: E402
+
 BIN, SCRATCH = sys.argv[1], sys.argv[2]
-WRITE_TABLE = "--write-table" in sys.argv[3:]
-TABLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "docs", "bad-inputs.md")
 failures = []
-rows = []  # (program, input, exit status, message) of each refused case, as the table shows them
+OPTIONAL = ("run_task", "generate_dataset", "pick_place_eval")
+
+
+def not_built_here(row):
+    """A documented row of an optional program this build does not make: kept, not checked."""
+    name = row.split("`")[1]
+    return name in OPTIONAL and not os.path.exists(os.path.join(BIN, name))
+
+
+FLAGS = Section("Program flags and output files", """
+Each program refuses a bad flag with exit status 2 and one line naming the flag, the value and
+the limit; an output it cannot write (a full disk: `/dev/full`) or a run that fails is exit status
+1, and the partial output is removed. Test `bad_inputs` (`tests/programs/test_bad_inputs.py`).
+""", ["program", "input", "exit", "message"], not_built_here)
+SCENES = Section("Scene files", """
+A scene file is read as strictly as JSON allows and then validated as a sampled scene is: a
+number out of range, a duplicate or unknown key, an object off the table, inside another or
+floating, and a goal that already holds or cannot be reached are refused before any step, naming
+the file, the key or the object and the reason. The files are scenes written by `scene_sample`,
+edited as the second column says. Test `bad_inputs` (`tests/programs/test_bad_inputs.py`).
+""", ["program", "scene file (edited)", "exit", "message"], not_built_here)
+TRACES = Section("Traces", """
+A trace (the per-step CSV that `run_task --trace` writes and `render_scene --trace` draws) must
+have the columns of its scene's objects and finite cells. Test `bad_inputs`
+(`tests/programs/test_bad_inputs.py`).
+""", ["program", "input", "exit", "message"], not_built_here)
 
 
 def program(name, required=True):
@@ -48,15 +70,16 @@ def run(prog, args):
     return done.returncode, done.stdout
 
 
-def refused(prog, args, expected, absent=(), code=None):
+def refused(prog, args, expected, absent=(), code=None, section=FLAGS, shown=None):
     """`prog args` exits non-zero (`code` if given), prints every string of `expected` and leaves
-    none of the paths `absent` (nor their temporary .tmp files)."""
+    none of the paths `absent` (nor their temporary .tmp files). The row shows `shown` for the
+    input when given (what was edited into a file), else the arguments."""
     if prog is None:
         return
     rc, out = run(prog, args)
     first = next((line for line in out.splitlines() if line.strip()), "")
     print(f"{os.path.basename(prog)} {' '.join(args)}\n    exit {rc}: {first}")
-    rows.append(table_row(os.path.basename(prog), args, rc, first))
+    section.add(f"`{os.path.basename(prog)}`", f"`{cell(shown or ' '.join(args), SCRATCH)}`", str(rc), cell(first, SCRATCH))
     problems = []
     if rc == 0 or (code is not None and rc != code):
         problems.append(f"exit status {rc}, expected {code if code is not None else 'non-zero'}")
@@ -64,47 +87,6 @@ def refused(prog, args, expected, absent=(), code=None):
     problems += [f"{p} was left behind" for p in absent for p in (p, p + ".tmp") if os.path.exists(p)]
     if problems:
         failures.append(f"{os.path.basename(prog)} {' '.join(args)}: " + "; ".join(problems) + "\n" + out)
-
-
-def table_row(name, args, rc, message):
-    """One line of docs/bad-inputs.md: the scratch folder written DIR, '|' escaped, decimals cut
-    to 6 places (the last digits of a divergence may differ between compilers)."""
-    cell = lambda text: re.sub(r"(\d\.\d{6})\d+", r"\1", text.replace(SCRATCH, "DIR").replace("|", "\\|"))
-    return f"| `{name}` | `{cell(' '.join(args))}` | {rc} | {cell(message)} |"
-
-
-TABLE_HEAD = """# Bad inputs and what the programs say
-
-Each row is a bad input tried on a command-line program and the first line of what the program
-says, with its exit status (1: refused by the library or a file that cannot be written; 2: a bad
-flag). The test `bad_inputs` (`tests/programs/test_bad_inputs.py`) runs every row and fails when
-this table no longer matches what the programs print; `test_bad_inputs.py BIN_DIR SCRATCH
---write-table` rewrites it. In every case nothing that looks like a complete output is left
-behind (checked by the same test). DIR stands for the test's scratch folder.
-
-| program | input | exit | message |
-|---|---|---|---|
-"""
-
-
-def check_table():
-    """The table against this run: see the module's docstring."""
-    built = {r.split("`")[1] for r in rows}
-    try:
-        documented = [line for line in open(TABLE).read().splitlines() if line.startswith("| `")]
-    except OSError:
-        documented = []
-    kept = [r for r in documented if r.split("`")[1] not in built]
-    if WRITE_TABLE:
-        with open(TABLE, "w") as f:
-            f.write(TABLE_HEAD + "\n".join(rows + kept) + "\n")
-        print(f"-- wrote {TABLE}: {len(rows)} rows from this run, {len(kept)} kept")
-        return
-    missing = [r for r in rows if r not in documented]
-    stale = [r for r in documented if r.split("`")[1] in built and r not in rows]
-    if missing or stale:
-        failures.append(f"{TABLE} does not match this run (rewrite it with --write-table):\n"
-                        + "".join(f"  not in the table: {r}\n" for r in missing) + "".join(f"  not printed any more: {r}\n" for r in stale))
 
 
 def accepted(prog, args):
@@ -178,45 +160,40 @@ def trace_of(scene_file, path):
     return path
 
 
-def scene_cases():
-    scene_sample, render_scene = program("scene_sample"), program("render_scene")
-    aln, arr = scratch("aln.json"), scratch("arr.json")
+def sampled(scene_sample, task):
+    """A clean scene of `task` (index 0, seed 0) written by scene_sample, or None."""
+    path = scratch(task.lower() + ".json")
+    accepted(scene_sample, ["--task", task, "--setting", "clean", "--index", "0", "--seed", "0", "--out", path, "--quiet"])
+    if not os.path.exists(path):
+        failures.append(f"scene_sample wrote no {task} scene: its scene file cases are skipped")
+        return None
+    return path
+
+
+def scene_edit(source, name, edit):
+    """`source` (a scene file) with `edit(scene)` applied, written as `name` in the scratch folder."""
+    scene = json.load(open(source))
+    edit(scene)
+    path = scratch(name)
+    json.dump(scene, open(path, "w"), indent=1)
+    return path
+
+
+def position(scene, i):
+    return scene["objects"][i]["pose"]["position"]
+
+
+def flag_cases():
+    scene_sample = program("scene_sample")
+    aln = scratch("aln.json")
     refused(scene_sample, ["--task", "ALN", "--setting", "clean", "--index", "-1", "--seed", "0", "--out", aln], ["--index must be >= 0 (got -1)"], [aln], 2)
     refused(scene_sample, ["--task", "ALN", "--setting", "clean", "--index", "0", "--seed", "-1", "--out", aln], ["--seed must be >= 0 (got -1)"], [aln], 2)
     refused(scene_sample, ["--task", "ALN", "--setting", "clean", "--index", "0", "--seed", "0", "--out", "/dev/full"],
             ["writing the scene file '/dev/full' failed"], code=1)
-    accepted(scene_sample, ["--task", "ALN", "--setting", "clean", "--index", "0", "--seed", "0", "--out", aln, "--quiet"])
-    accepted(scene_sample, ["--task", "ARR", "--setting", "clean", "--index", "0", "--seed", "0", "--out", arr, "--quiet"])
-    if not (os.path.exists(aln) and os.path.exists(arr)):
-        failures.append("scene_sample wrote no scene: the scene file cases are skipped")
-        return aln, None
-    images = scratch("images")
-    huge = edited(aln, scratch("huge.json"), r'"half_x": [-+0-9.e]+', '"half_x": 1e400')
-    refused(render_scene, ["--scene", huge, "--out", images], [huge, "1e400"], [images])
-    duplicate = edited(aln, scratch("duplicate.json"), '"friction": ', '"friction": 0.1, "friction": ')
-    refused(render_scene, ["--scene", duplicate, "--out", images], [duplicate + ": table.friction: duplicate key"], [images])
-    misspelled = edited(aln, scratch("misspelled.json"), '"rolling_resistance"', '"rolling_resistence"')
-    refused(render_scene, ["--scene", misspelled, "--out", images], [misspelled + ": table.rolling_resistence: unknown field"], [images])
-    # one scene drawn at another scene's trace: ARR's objects are not ALN's
-    arr_trace = trace_of(arr, scratch("arr.csv"))
-    refused(render_scene, ["--scene", aln, "--trace", arr_trace, "--out", images], [arr_trace, "recorded in another scene"], [images])
-    # a frame that fails to draw (a zero quaternion) after the output folder was made: the new folders go again
-    zero = edited(arr_trace, scratch("zero_quaternion.csv"), r"(\n(?:[^,]*,){9})0,1,0,0,", r"\g<1>0,0,0,0,")  # gripper_qw..qz
-    nested = os.path.join(SCRATCH, "new", "images")
-    refused(render_scene, ["--scene", arr, "--trace", zero, "--out", nested], ["quaternion of 'gripper' has zero norm"], [os.path.dirname(nested)], 1)
-    accepted(render_scene, ["--scene", arr, "--trace", arr_trace, "--out", images])
-    if render_scene and not os.path.exists(os.path.join(images, "rgb.png")):
-        failures.append("render_scene --scene arr.json --trace arr.csv wrote no rgb.png")
-    return aln, huge
-
-
-def optional_cases(aln, huge):
-    run_task, generate_dataset, pick_place_eval = (program(p, required=False) for p in ("run_task", "generate_dataset", "pick_place_eval"))
+    run_task, generate_dataset, pick_place_eval = (program(p, required=False) for p in OPTIONAL)
     refused(run_task, ["--task", "ALN", "--index", "-1"], ["--index must be >= 0 (got -1)"], code=2)
     refused(run_task, ["--task", "ALN", "--seed", "-1"], ["--seed must be >= 0 (got -1)"], code=2)
     refused(run_task, ["--task", "ALN", "--path-speed", "0"], ["--path-speed must be > 0 (got 0)"], code=2)
-    if huge:
-        refused(run_task, ["--scene", huge, "--quiet"], [huge, "1e400"], code=1)
     dataset = scratch("dataset")
     refused(generate_dataset, ["--tasks", "ALN", "--clean", "1", "--seed", "-1", "--out", dataset], ["--seed must be >= 0 (got -1)"], [dataset], 2)
     refused(generate_dataset, ["--tasks", "ALN", "--clean", "-1", "--out", dataset], ["--clean must be >= 0 (got -1)"], [dataset], 2)
@@ -225,14 +202,82 @@ def optional_cases(aln, huge):
     refused(pick_place_eval, ["--episodes", "1", "--seed", "1", "--mass", "9", "--out", out], ["--mass must be in [0.001, 5] (got 9)"], [out], 2)
 
 
+def scene_file_cases():
+    scene_sample, render_scene, run_task = program("scene_sample"), program("render_scene"), program("run_task", required=False)
+    aln, arr, coll, stk, ovr = (sampled(scene_sample, t) for t in ("ALN", "ARR", "COLL", "STK", "OVR"))
+    if None in (aln, arr, coll, stk, ovr):
+        return
+    images = scratch("images")
+    huge = edited(aln, scratch("huge.json"), r'"half_x": [-+0-9.e]+', '"half_x": 1e400')
+    refused(render_scene, ["--scene", huge, "--out", images], [huge, "1e400"], [images], section=SCENES, shown="huge.json: table.half_x 1e400")
+    refused(run_task, ["--scene", huge, "--quiet"], [huge, "1e400"], code=1, section=SCENES, shown="huge.json: table.half_x 1e400")
+    duplicate = edited(aln, scratch("duplicate.json"), '"friction": ', '"friction": 0.1, "friction": ')
+    refused(render_scene, ["--scene", duplicate, "--out", images], [duplicate + ": table.friction: duplicate key"], [images],
+            section=SCENES, shown="duplicate.json: table.friction given twice")
+    misspelled = edited(aln, scratch("misspelled.json"), '"rolling_resistance"', '"rolling_resistence"')
+    refused(render_scene, ["--scene", misspelled, "--out", images], [misspelled + ": table.rolling_resistence: unknown field"], [images],
+            section=SCENES, shown="misspelled.json: table.rolling_resistence")
+    # scenes that run_task must not run: each (file, what was edited, words the refusal must say)
+    for name, source, shown, edit, words in [
+            ("in_container.json", coll, "COLL: the object already in the basket (z + 0.005 over the basket's origin)",
+             lambda s: s["objects"][1]["pose"].update(position=[*position(s, 0)[:2], position(s, 0)[2] + 0.005]),
+             ["the goal already holds before any step (inside"]),
+            ("stacked.json", stk, "STK: the plates already stacked",
+             lambda s: s["objects"][1]["pose"].update(position=[*position(s, 0)[:2], position(s, 0)[2] + 0.005]),
+             ["the goal already holds before any step (above_below, centred_on_below"]),
+            ("smallest_first.json", stk, "STK: goal.items listed narrowest first",
+             lambda s: s["goal"].update(items=s["goal"]["items"][::-1]), ["items go from the widest (bottom) to the narrowest (top)"]),
+            ("container_without_receptacle.json", coll, "COLL: goal.container names the sand clock",
+             lambda s: s["goal"].update(container=1, object=0), ["goal.container = 1 ('sand_clock/03') has no receptacle"]),
+            ("goal_object_5.json", coll, "COLL: goal.object 5 of 2 objects", lambda s: s["goal"].update(object=5),
+             ["goal.object = 5 is out of range: the scene has 2 objects"]),
+            ("below_table.json", coll, "COLL: objects[1] at z 0.5, below the table top", lambda s: position(s, 1).__setitem__(2, 0.5),
+             ["objects[1].pose position z = 0.5 is not on the table"]),
+            ("far_away.json", coll, "COLL: objects[1] at z 1e308", lambda s: position(s, 1).__setitem__(2, 1e308),
+             ["objects[1].pose position z = 1e+308 is not on the table"]),
+            ("floating.json", coll, "COLL: objects[1] 0.15 m above the table", lambda s: position(s, 1).__setitem__(2, 0.9),
+             ["unstable placement: object 1 (sand_clock/03) drifted"]),
+            ("twice.json", coll, "COLL: objects[1] listed twice (one pose)", lambda s: s["objects"].append(dict(s["objects"][1])),
+             ["interpenetration: object 1 (sand_clock/03) and object 2 (sand_clock/03) overlap"]),
+            ("in_obstacle.json", ovr, "OVR: the bottle inside the vase (the obstacle)",
+             lambda s: s["objects"][0]["pose"].update(position=list(s["obstacles"][0]["pose"]["position"])), ["not a valid scene"])]:
+        path = scene_edit(source, name, edit)
+        refused(run_task, ["--scene", path, "--quiet"], [path] + words, code=1, section=SCENES, shown=f"{name}: {shown}")
+    return aln, arr
+
+
+def trace_cases(aln, arr):
+    render_scene = program("render_scene")
+    images = scratch("images")
+    # one scene drawn at another scene's trace: ARR's objects are not ALN's
+    arr_trace = trace_of(arr, scratch("arr.csv"))
+    refused(render_scene, ["--scene", aln, "--trace", arr_trace, "--out", images], [arr_trace, "recorded in another scene"], [images], section=TRACES)
+    # a frame that fails to draw (a zero quaternion) after the output folder was made: the new folders go again
+    zero = edited(arr_trace, scratch("zero_quaternion.csv"), r"(\n(?:[^,]*,){9})0,1,0,0,", r"\g<1>0,0,0,0,")  # gripper_qw..qz
+    nested = os.path.join(SCRATCH, "new", "images")
+    refused(render_scene, ["--scene", arr, "--trace", zero, "--out", nested], [zero, "row 0: quaternion of 'gripper' has zero norm"], [os.path.dirname(nested)], 1, section=TRACES)
+    nan = edited(arr_trace, scratch("nan_cell.csv"), r"(\n(?:[^,]*,){6})[^,]*,", r"\g<1>nan,")  # gripper_px
+    refused(render_scene, ["--scene", arr, "--trace", nan, "--out", images], [nan, "gripper_px"], [images], 1, section=TRACES)
+    no_column = edited(arr_trace, scratch("no_node3_y.csv"), r",node3_y,", ",node3_w,")
+    refused(render_scene, ["--scene", arr, "--trace", no_column, "--out", images], [no_column, "no column 'node3_y'"], [images], 1, section=TRACES)
+    short = edited(arr_trace, scratch("short_row.csv"), r",[^,\n]*\n$", "\n")
+    refused(render_scene, ["--scene", arr, "--trace", short, "--out", images], [short], [images], 1, section=TRACES)
+    accepted(render_scene, ["--scene", arr, "--trace", arr_trace, "--out", images])
+    if render_scene and not os.path.exists(os.path.join(images, "rgb.png")):
+        failures.append("render_scene --scene arr.json --trace arr.csv wrote no rgb.png")
+
+
 def main():
     shutil.rmtree(SCRATCH, ignore_errors=True)
     os.makedirs(SCRATCH)
     rod_sim_cases()
     reach_eval_cases()
-    aln, huge = scene_cases()
-    optional_cases(aln, huge)
-    check_table()
+    flag_cases()
+    scenes = scene_file_cases()
+    if scenes:
+        trace_cases(*scenes)
+    for section in (FLAGS, SCENES, TRACES):
+        section.finish(failures)
     for f in failures:
         print("FAILED:", f)
     print(f"{len(failures)} failure(s)")

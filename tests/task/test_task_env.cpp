@@ -170,6 +170,10 @@ TEST_CASE("episodes end for the documented reasons: goal already met, object off
     e.reset(coll);
     CHECK(e.info().failure == FailureReason::scene_invalid);
     CHECK(e.conditions().holds("inside"));
+    // a scene file or a Python caller is told which conditions held already
+    CHECK_THROWS_WITH(require_a_task(e, "coll.json"),
+                      Catch::Matchers::StartsWith("coll.json: the goal already holds before any step (inside") &&
+                          Catch::Matchers::EndsWith("): the scene is no task"));
     // The stack's items one above the other at the bottom item's place, 3 cm apart in height.
     SceneSpec stk = sample(Task::stk, 0);
     const Eigen::Vector3d bottom = stk.objects.at(static_cast<std::size_t>(stk.goal.items.front())).pose.translation;
@@ -180,6 +184,7 @@ TEST_CASE("episodes end for the documented reasons: goal already met, object off
     // The sampled scenes themselves are tasks.
     e.reset(sample(Task::stk, 0));
     CHECK_FALSE(e.done());
+    CHECK_NOTHROW(require_a_task(e, "stk.json"));
     CHECK_FALSE(e.conditions().all());
   }
   SECTION("a cup placed beyond the table's front edge falls off: object_off_table") {

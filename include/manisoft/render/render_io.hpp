@@ -25,16 +25,18 @@ namespace manisoft::render::io {
 
 /// A world_demo trace: column names and numeric rows.
 struct Trace {
+  std::string name;  ///< the file read (messages name it)
   std::vector<std::string> columns;
   std::map<std::string, std::size_t> index;
   std::vector<std::vector<double>> rows;
 
   double at(std::size_t row, const std::string& column) const {
     auto it = index.find(column);
-    if (it == index.end()) manisoft::detail::fail("trace: no column '", column, "'");
+    if (it == index.end()) manisoft::detail::fail(where(), ": no column '", column, "'");
     return rows[row][it->second];
   }
   bool has(const std::string& column) const { return index.count(column) > 0; }
+  std::string where() const { return name.empty() ? "trace" : "trace " + name; }
 };
 
 inline std::vector<std::string> split_csv(const std::string& line) {
@@ -54,6 +56,7 @@ inline Trace read_trace(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) manisoft::detail::fail("trace ", path.string(), ": cannot open the file");
   Trace t;
+  t.name = path.string();
   std::string line;
   if (!std::getline(in, line)) manisoft::detail::fail("trace ", path.string(), ": empty file (no header row)");
   t.columns = split_csv(line);
@@ -106,7 +109,7 @@ inline void require_trace_matches(const tabletop::TabletopScene& scene, const Tr
 
 inline math::Pose<double> pose_from(const Trace& t, std::size_t row, const std::string& prefix) {
   Eigen::Quaterniond q(t.at(row, prefix + "_qw"), t.at(row, prefix + "_qx"), t.at(row, prefix + "_qy"), t.at(row, prefix + "_qz"));
-  if (!(q.norm() > 1e-9)) manisoft::detail::fail("trace row ", row, ": quaternion of '", prefix, "' has zero norm");
+  if (!(q.norm() > 1e-9)) manisoft::detail::fail(t.where(), " row ", row, ": quaternion of '", prefix, "' has zero norm");
   math::Pose<double> pose;
   pose.rotation = q.normalized().toRotationMatrix();
   pose.translation = Eigen::Vector3d(t.at(row, prefix + "_px"), t.at(row, prefix + "_py"), t.at(row, prefix + "_pz"));
@@ -117,7 +120,7 @@ inline math::Pose<double> pose_from(const Trace& t, std::size_t row, const std::
 /// run_task): rod nodes (frames derived from the centreline: the trace has no directors), gripper
 /// pose and opening, object poses.
 inline FrameState frame_from_trace(const tabletop::TabletopScene& scene, const Trace& t, std::size_t row) {
-  if (row >= t.rows.size()) manisoft::detail::fail("trace: frame ", row, " is out of range: the trace has ", t.rows.size(), " rows (0..", t.rows.size() - 1, ")");
+  if (row >= t.rows.size()) manisoft::detail::fail(t.where(), ": frame ", row, " is out of range: the trace has ", t.rows.size(), " rows (0..", t.rows.size() - 1, ")");
   FrameState f = scene.frame;
   int nodes = 0;
   while (t.has("node" + std::to_string(nodes) + "_x")) ++nodes;

@@ -43,18 +43,22 @@ class Conditions {
     ::manisoft::detail::fail("Conditions: no condition named '", name, "'");
   }
   /// The names of the conditions that do not hold, comma-separated ("" when all hold).
-  std::string unmet() const {
-    std::string out;
-    for (std::size_t i = 0; i < count_; ++i)
-      if (!items_[i].holds) out += (out.empty() ? "" : ", ") + std::string(items_[i].name);
-    return out;
-  }
+  std::string unmet() const { return names_where(false); }
+  /// The names of the conditions that hold, comma-separated.
+  std::string met() const { return names_where(true); }
 
   std::size_t size() const { return count_; }
   const Condition* begin() const { return items_.data(); }
   const Condition* end() const { return items_.data() + count_; }
 
  private:
+  std::string names_where(bool holds) const {
+    std::string out;
+    for (std::size_t i = 0; i < count_; ++i)
+      if (items_[i].holds == holds) out += (out.empty() ? "" : ", ") + std::string(items_[i].name);
+    return out;
+  }
+
   std::array<Condition, capacity> items_{};
   std::size_t count_ = 0;
 };

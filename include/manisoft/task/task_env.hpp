@@ -34,6 +34,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -345,5 +346,13 @@ class TaskEnv {
   bool touched_obstacle_ = false, dropped_ = false;
   long last_event_step_ = 0;
 };
+
+/// Refuses a scene that is no task, after `env.reset(spec)`: its goal held before any step (the
+/// episode ended as scene_invalid). `where` names the scene's file or source in the message.
+inline void require_a_task(const TaskEnv& env, std::string_view where) {
+  if (env.info().failure == FailureReason::scene_invalid)
+    ::manisoft::detail::fail(where, ": the goal already holds before any step (", env.conditions().met(),
+                             "): the scene is no task");
+}
 
 }  // namespace manisoft::task
