@@ -75,7 +75,7 @@ py::dict reach_action_spec(const Env& env) {
   const auto& limits = env.config().limits;
   Array3 high(env.n_elements(), 3);
   for (int k = 0; k < env.n_elements(); ++k)
-    for (int c = 0; c < 3; ++c) high(k, c) = k == 0 ? 0.0 : limits.limit(c);
+    for (int c = 0; c < 3; ++c) high(k, c) = limits.bound(k, c);
   py::dict d;
   d["shape"] = py::make_tuple(env.n_elements(), 3);
   d["dtype"] = "float64";
@@ -85,8 +85,7 @@ py::dict reach_action_spec(const Env& env) {
 }
 
 py::dict reach_observation_spec(const Env& env) {
-  const auto nodes = static_cast<int>(env.config().rod.n_elements / env.config().observe_stride + 1 +
-                                      (env.config().rod.n_elements % env.config().observe_stride ? 1 : 0));
+  const auto nodes = static_cast<int>(env.observation().node_positions.rows());
   py::dict d;
   d["end_effector"] = py::make_tuple(py::make_tuple(4, 4), "float64");
   d["target"] = py::make_tuple(py::make_tuple(4, 4), "float64");
@@ -316,7 +315,7 @@ class StateRenderer {
 
 }  // namespace
 
-PYBIND11_MODULE(manisoft, m) {
+PYBIND11_MODULE(_manisoft, m) {
   m.doc() = "ManiSoft: soft continuum arm simulation and benchmark environments (Gymnasium-style API)";
   py::register_exception_translator([](std::exception_ptr p) {
     try {

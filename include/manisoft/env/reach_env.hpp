@@ -150,6 +150,8 @@ class ReachEnv {
   int n_elements() const { return config_.rod.n_elements; }
   /// The action space: rows() x 3 actions, apply() to element torques, project() from them.
   const Action& action_space() const { return action_space_; }
+  /// The last observation (before the first reset: zeros, laid out as every later one).
+  const control::Observation<double>& observation() const { return observation_; }
 
   /// Starts an episode: draws the target of `seed` and puts the arm straight at rest.
   const control::Observation<double>& reset(std::uint64_t seed) {

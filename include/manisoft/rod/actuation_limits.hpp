@@ -18,6 +18,8 @@ struct ActuationLimits {
   Scalar bend = Scalar(150);
   Scalar twist = Scalar(75);
   Scalar limit(int component) const { return component < 2 ? bend : twist; }
+  /// The bound of element `element`'s torque component `component` (element 0: none, zero).
+  Scalar bound(int element, int component) const { return element == 0 ? Scalar(0) : limit(component); }
   void validate() const {
     manisoft::detail::require_positive("ActuationLimits bend", bend);
     manisoft::detail::require_positive("ActuationLimits twist", twist);
@@ -31,7 +33,7 @@ int clamp_to_limits(const ActuationLimits<Scalar>& limits, Torques& torques) {
   int clamped = 0;
   for (int k = 0; k < torques.rows(); ++k)
     for (int c = 0; c < 3; ++c) {
-      const Scalar lim = k == 0 ? Scalar(0) : limits.limit(c);
+      const Scalar lim = limits.bound(k, c);
       const Scalar t = torques(k, c);
       torques(k, c) = std::clamp(t, -lim, lim);
       if (k > 0 && std::abs(t) > lim) ++clamped;
