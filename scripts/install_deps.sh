@@ -12,6 +12,8 @@ packages+=(libhdf5-dev python3-h5py python3-numpy)
 packages+=(parallel python3-matplotlib python3-zarr)
 # the Python module (pybind11, for Debian's /usr/bin/python3)
 packages+=(pybind11-dev python3-dev)
+# installing it as a Python package: pip install --no-build-isolation . (setup.py), offline
+packages+=(python3-pip python3-setuptools python3-wheel python3-venv)
 # the evaluation harness's policy-server client (openpi's websocket + msgpack protocol)
 packages+=(python3-websockets python3-msgpack python3-msgpack-numpy)
 missing=()

@@ -279,7 +279,8 @@ class ReachVectorEnv:
 
     Observations: dict of end_effector, target (B x 4 x 4), node_positions, node_velocities
     (B x m x 3). Infos: dict of arrays of leading dimension B: success, steps, position_error,
-    rotation_error, clipped, max_node_speed, seed (every key holds every arm's value).
+    rotation_error, clipped, max_node_speed, seed, each with Gymnasium's mask "_key" (a bool array
+    of B saying which arms have the key: every arm has every key, so it is all True).
     Arrays: every returned array is a read-only numpy view of the batch's own buffers (no copy):
     the next reset or step overwrites it; copy (np.array(x)) what you keep across steps.
     The GIL is released while the batch resets and steps (over num_threads threads).
@@ -307,6 +308,8 @@ class ReachVectorEnv:
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self._first_seed = _count(seed, "make_vec_env: seed")
         self._arrays = self._batch.arrays()
+        self._every_arm = np.ones(self.num_envs, dtype=bool)  # the infos' "_key" masks: every arm has every key
+        self._every_arm.flags.writeable = False
         self._started = False
         self.closed = False
 
@@ -389,6 +392,8 @@ class ReachVectorEnv:
     def _infos(self):
         infos = {key: self._arrays[key] for key in self._INFOS}
         infos["seed"] = self._arrays["seeds"]
+        for key in list(infos):
+            infos["_" + key] = self._every_arm
         return infos
 
 

@@ -4,8 +4,8 @@ reads it: the index file DIR/dataset.hdf5 links every episode under data/demo_<k
 
 usage: /usr/bin/python3 read_dataset.py DIR
 """
+import argparse
 import json
-import sys
 
 import h5py
 import numpy as np
@@ -40,6 +40,6 @@ def main(folder):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 2:
-        sys.exit(__doc__)
-    main(sys.argv[1])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("folder", help="the dataset folder (holding dataset.hdf5)")
+    main(parser.parse_args().folder)

@@ -125,6 +125,9 @@ class VecEnvApi(unittest.TestCase):
         self.assertEqual((terminated.dtype, truncated.dtype), (np.bool_, np.bool_))
         for key in INFOS + ("max_node_speed", "seed"):
             self.assertEqual(info[key].shape, (B,), key)
+            mask = info["_" + key]  # Gymnasium's vector info convention: which arms have the key (all)
+            self.assertEqual((mask.dtype, mask.tolist()), (np.bool_, [True] * B), key)
+        self.assertEqual(sorted(k for k in info if not k.startswith("_")), sorted(k[1:] for k in info if k.startswith("_")))
         self.assertTrue(self.vec.observation_space.contains(obs))
         with self.assertRaises(ValueError):  # a view of the batch's buffer: read-only
             obs["end_effector"][0, 0, 0] = 1.0
