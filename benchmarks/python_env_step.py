@@ -26,7 +26,7 @@ def main():
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--render-steps", type=int, default=300, help="steps of the rendered runs")
     args = p.parse_args()
-    env = manisoft.make_env("COLL", "clean", seed=0)
+    env = manisoft.make_env("COLL", "clean", seed=0, render=False)
     env.reset(options={"index": 3})
     actions = []
     while True:

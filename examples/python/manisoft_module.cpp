@@ -34,6 +34,7 @@
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/env/batched_reach_env.hpp"
 #include "manisoft/env/reach_env.hpp"
+#include "manisoft/task/batched_task_env.hpp"
 #include "task_environment.hpp"
 
 namespace py = pybind11;
@@ -213,6 +214,16 @@ class ReachEnvironment {
   manisoft_py::ThreadUse threads_;
 };
 
+/// A read-only numpy view of a batch buffer, kept alive by `owner` (flags: numpy bool over the
+/// same 0 / 1 bytes).
+template <typename T>
+py::array batch_view(std::span<const T> data, std::vector<py::ssize_t> shape, const py::object& owner) {
+  const py::dtype type = std::is_same_v<T, std::uint8_t> ? py::dtype::of<bool>() : py::dtype::of<T>();
+  py::array out(type, std::move(shape), {}, data.data(), owner);
+  py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return out;
+}
+
 /// The batched reach environment's compiled half (env/batched_reach_env.hpp); manisoft.make_vec_env
 /// wraps it with Gymnasium's vector API (manisoft_vec.py). Its arrays are numpy views of the batch's
 /// own buffers, kept alive by the object and overwritten by every reset and step.
@@ -243,20 +254,20 @@ class ReachBatch {
     const auto& b = owner.cast<const ReachBatch&>().batch_;
     const py::ssize_t n = b.batch_size(), m = b.observed_nodes();
     py::dict d;
-    d["end_effector"] = view(b.end_effector(), {n, 4, 4}, owner);
-    d["target"] = view(b.target(), {n, 4, 4}, owner);
-    d["node_positions"] = view(b.node_positions(), {n, m, 3}, owner);
-    d["node_velocities"] = view(b.node_velocities(), {n, m, 3}, owner);
-    d["rewards"] = view(b.rewards(), {n}, owner);
-    d["terminated"] = view(b.terminated(), {n}, owner);
-    d["truncated"] = view(b.truncated(), {n}, owner);
-    d["success"] = view(b.success(), {n}, owner);
-    d["steps"] = view(b.steps(), {n}, owner);
-    d["position_error"] = view(b.position_error(), {n}, owner);
-    d["rotation_error"] = view(b.rotation_error(), {n}, owner);
-    d["clipped"] = view(b.clipped(), {n}, owner);
-    d["max_node_speed"] = view(b.max_node_speed(), {n}, owner);
-    d["seeds"] = view(b.seeds(), {n}, owner);
+    d["end_effector"] = batch_view(b.end_effector(), {n, 4, 4}, owner);
+    d["target"] = batch_view(b.target(), {n, 4, 4}, owner);
+    d["node_positions"] = batch_view(b.node_positions(), {n, m, 3}, owner);
+    d["node_velocities"] = batch_view(b.node_velocities(), {n, m, 3}, owner);
+    d["rewards"] = batch_view(b.rewards(), {n}, owner);
+    d["terminated"] = batch_view(b.terminated(), {n}, owner);
+    d["truncated"] = batch_view(b.truncated(), {n}, owner);
+    d["success"] = batch_view(b.success(), {n}, owner);
+    d["steps"] = batch_view(b.steps(), {n}, owner);
+    d["position_error"] = batch_view(b.position_error(), {n}, owner);
+    d["rotation_error"] = batch_view(b.rotation_error(), {n}, owner);
+    d["clipped"] = batch_view(b.clipped(), {n}, owner);
+    d["max_node_speed"] = batch_view(b.max_node_speed(), {n}, owner);
+    d["seeds"] = batch_view(b.seeds(), {n}, owner);
     return d;
   }
 
@@ -267,16 +278,89 @@ class ReachBatch {
   py::dict observation_space() const { return reach_observation_spec(batch_.arm(0)); }
 
  private:
-  /// A read-only view of a batch buffer (flags: numpy bool over the same 0 / 1 bytes).
-  template <typename T>
-  static py::array view(std::span<const T> data, std::vector<py::ssize_t> shape, const py::object& owner) {
-    const py::dtype type = std::is_same_v<T, std::uint8_t> ? py::dtype::of<bool>() : py::dtype::of<T>();
-    py::array out(type, std::move(shape), {}, data.data(), owner);
-    py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  manisoft::env::BatchedReachEnv<> batch_;
+  manisoft_py::ThreadUse threads_;
+};
+
+/// The batched task environment's compiled half (task/batched_task_env.hpp); manisoft.make_vec_env
+/// wraps it with Gymnasium's vector API (manisoft_vec.py). Its arrays are numpy views as ReachBatch's.
+class TaskBatch {
+ public:
+  TaskBatch(const std::string& task, const std::string& setting, const std::string& split, std::uint64_t seed, int num_envs, int threads)
+      : batch_(num_envs, threads, settings(task, setting, split, seed)) {}
+
+  /// Resets the arms with mask[i] (every arm when mask is None), arm i on scene index indices[i].
+  void reset(const Seeds& indices, const std::optional<Flags>& mask) {
+    const auto entered = threads_.enter("reset");
+    py::gil_scoped_release release;
+    if (mask)
+      batch_.reset(std::span<const std::uint8_t>(mask->data(), std::size_t(mask->size())), std::span<const std::uint64_t>(indices.data(), std::size_t(indices.size())));
+    else
+      batch_.reset(std::span<const std::uint64_t>(indices.data(), std::size_t(indices.size())));
+  }
+
+  /// One step of every arm: actions hold num_envs x (3n + 1) float64 values (C order).
+  void step(const Actions& actions) {
+    const auto entered = threads_.enter("step");
+    py::gil_scoped_release release;
+    batch_.step(std::span<const double>(actions.data(), std::size_t(actions.size())));
+  }
+
+  static py::dict arrays(const py::object& owner) {
+    const auto& b = owner.cast<const TaskBatch&>().batch_;
+    const py::ssize_t n = b.batch_size(), k = b.max_objects();
+    py::dict d;
+    d["rod_nodes"] = batch_view(b.rod_nodes(), {n, b.n_elements() + 1, 3}, owner);
+    d["end_effector"] = batch_view(b.end_effector(), {n, 4, 4}, owner);
+    d["gripper_pose"] = batch_view(b.gripper_pose(), {n, 4, 4}, owner);
+    d["gripper_width"] = batch_view(b.gripper_width(), {n}, owner);
+    d["gripper_state"] = batch_view(b.gripper_state(), {n}, owner);
+    d["object_poses"] = batch_view(b.object_poses(), {n, k, 4, 4}, owner);
+    d["object_count"] = batch_view(b.object_count(), {n}, owner);
+    d["rewards"] = batch_view(b.rewards(), {n}, owner);
+    d["terminated"] = batch_view(b.terminated(), {n}, owner);
+    d["truncated"] = batch_view(b.truncated(), {n}, owner);
+    d["success"] = batch_view(b.success(), {n}, owner);
+    d["steps"] = batch_view(b.steps(), {n}, owner);
+    d["failure"] = batch_view(b.failure(), {n}, owner);
+    d["indices"] = batch_view(b.indices(), {n}, owner);
+    return d;
+  }
+
+  /// The instruction of each arm's scene.
+  py::tuple instructions() const {
+    py::tuple out(batch_.batch_size());
+    for (int i = 0; i < batch_.batch_size(); ++i) out[i] = batch_.instruction(i);
+    return out;
+  }
+  /// Each arm's failure reason: None, or its name (as the single environment's info["failure"]).
+  py::tuple failures() const {
+    py::tuple out(batch_.batch_size());
+    const auto f = batch_.failure();
+    for (int i = 0; i < batch_.batch_size(); ++i) {
+      const auto reason = static_cast<manisoft::task::FailureReason>(f[std::size_t(i)]);
+      out[i] = reason == manisoft::task::FailureReason::none ? py::object(py::none()) : py::object(py::str(std::string(manisoft::task::to_string(reason))));
+    }
     return out;
   }
 
-  manisoft::env::BatchedReachEnv<> batch_;
+  int num_envs() const { return batch_.batch_size(); }
+  int threads() const { return batch_.threads(); }
+  int n_elements() const { return batch_.n_elements(); }
+  int max_objects() const { return batch_.max_objects(); }
+  py::dict action_space() const { return manisoft_py::task_action_spec(batch_.n_elements()); }
+
+ private:
+  static manisoft::task::BatchedTaskEnv::Settings settings(const std::string& task, const std::string& setting, const std::string& split, std::uint64_t seed) {
+    manisoft::task::BatchedTaskEnv::Settings s;
+    s.task = manisoft::scene::parse_task(task);
+    s.setting = manisoft::scene::parse_setting(setting);
+    s.split = manisoft::scene::parse_split(split);
+    s.seed = seed;
+    return s;
+  }
+
+  manisoft::task::BatchedTaskEnv batch_;
   manisoft_py::ThreadUse threads_;
 };
 
@@ -346,6 +430,20 @@ PYBIND11_MODULE(_manisoft, m) {
       .def_property_readonly("action_rows", &ReachBatch::action_rows)
       .def("_action_space_spec", &ReachBatch::action_space)
       .def("_observation_space_spec", &ReachBatch::observation_space);
+  py::class_<TaskBatch>(m, "_TaskBatch", "B task environments stepped together (use manisoft.make_vec_env)")
+      .def(py::init<const std::string&, const std::string&, const std::string&, std::uint64_t, int, int>(), py::arg("task"), py::arg("setting"),
+           py::arg("split"), py::arg("seed"), py::arg("num_envs"), py::arg("threads"))
+      .def("reset", &TaskBatch::reset, py::arg("indices"), py::arg("mask") = py::none())
+      .def("step", &TaskBatch::step, py::arg("actions"))
+      .def("arrays", [](const py::object& self) { return TaskBatch::arrays(self); })
+      .def("instructions", &TaskBatch::instructions)
+      .def("failures", &TaskBatch::failures)
+      .def_property_readonly("num_envs", &TaskBatch::num_envs)
+      .def_property_readonly("threads", &TaskBatch::threads)
+      .def_property_readonly("n_elements", &TaskBatch::n_elements)
+      .def_property_readonly("max_objects", &TaskBatch::max_objects)
+      .def("_action_space_spec", &TaskBatch::action_space)
+      .def("_observation_space_spec", [](const TaskBatch&) { return py::dict(); });
   using manisoft_py::TaskEnvironment;
   py::class_<TaskEnvironment>(m, "TaskEnv",
                               "A ManiSoft task (COLL, ALN, STK, ARR): instruction and camera image in, torques and gripper state out (paper section 3.2)")
@@ -379,9 +477,10 @@ PYBIND11_MODULE(_manisoft, m) {
           throw py::value_error("make_env: the tasks' horizon is the paper's T = " + std::to_string(task_horizon) + " (got " + std::to_string(horizon) + ")");
         return py::cast(std::make_unique<TaskEnvironment>(name, setting, seed, render, camera, privileged, split));
       },
-      py::arg("name"), py::arg("setting") = "clean", py::arg("seed") = 0, py::arg("render") = false, py::arg("camera") = py::none(),
+      py::arg("name"), py::arg("setting") = "clean", py::arg("seed") = 0, py::arg("render") = true, py::arg("camera") = py::none(),
       py::arg("privileged") = false, py::arg("split") = "train", py::arg("target_set") = "table", py::arg("horizon") = task_horizon,
-      "Makes an environment: make_env(task, 'clean'|'randomized', seed=0, render=False, camera=None, privileged=False, split='train') "
+      "Makes an environment: make_env(task, 'clean'|'randomized', seed=0, render=True, camera=None, privileged=False, split='train') "
+      "(the paper's observation: image and instruction; privileged=True adds the state, render=False leaves the image out) "
       "for a task of manisoft.tasks(), or make_env('reach', target_set='table'|'equilibria', seed=0, horizon=HORIZON)");
   // The tasks and the episode's timing, from the one definition of each (task/registry.hpp, TaskEnvConfig).
   m.def(

@@ -203,6 +203,30 @@ using PolicyRenderer = ms::render::GlRenderer;
 /// A renderer for the image a policy sees: shadows on, only colour read back.
 inline std::unique_ptr<PolicyRenderer> make_policy_renderer() { return ms::render::make_colour_renderer<PolicyRenderer>(); }
 
+/// A task's flat action space as plain values (manisoft_vec.py makes a Box of it): the n x 3
+/// element torques within the actuation limits, then S in [0, 1].
+inline py::dict task_action_spec(int n) {
+  using Action = ms::control::FlatAction;
+  const ms::rod::ActuationLimits<double> lim = ms::world::ArmWorldSettings{}.limits;  // TaskEnv's world keeps the defaults
+  py::array_t<double> low(Action::size(n)), high(Action::size(n));
+  auto l = low.mutable_unchecked<1>();
+  auto h = high.mutable_unchecked<1>();
+  for (int k = 0; k < n; ++k)
+    for (int c = 0; c < 3; ++c) {
+      h(Action::torque(k, c)) = lim.bound(k, c);
+      l(Action::torque(k, c)) = -lim.bound(k, c);
+    }
+  l(Action::gripper(n)) = 0.0;
+  h(Action::gripper(n)) = 1.0;
+  py::dict d;
+  d["shape"] = py::make_tuple(Action::size(n));
+  d["dtype"] = "float64";
+  d["low"] = low;
+  d["high"] = high;
+  d["layout"] = "element torques (n x 3, material frame d1 d2 d3, row by row; element 0 fixed at 0) then S (>= 0.5 closed)";
+  return d;
+}
+
 class TaskEnvironment {
  public:
   using Array3 = ms::task::TaskEnv::Array3;
@@ -310,26 +334,7 @@ class TaskEnvironment {
     return renderer_->render();
   }
 
-  py::dict action_space() const {
-    const ms::rod::ActuationLimits<double> lim = ms::world::ArmWorldSettings{}.limits;  // TaskEnv's world keeps the defaults
-    py::array_t<double> low(Action::size(n_)), high(Action::size(n_));
-    auto l = low.mutable_unchecked<1>();
-    auto h = high.mutable_unchecked<1>();
-    for (int k = 0; k < n_; ++k)
-      for (int c = 0; c < 3; ++c) {
-        h(Action::torque(k, c)) = k == 0 ? 0.0 : lim.limit(c);
-        l(Action::torque(k, c)) = -h(Action::torque(k, c));
-      }
-    l(Action::gripper(n_)) = 0.0;
-    h(Action::gripper(n_)) = 1.0;
-    py::dict d;
-    d["shape"] = py::make_tuple(Action::size(n_));
-    d["dtype"] = "float64";
-    d["low"] = low;
-    d["high"] = high;
-    d["layout"] = "element torques (n x 3, material frame d1 d2 d3, row by row; element 0 fixed at 0) then S (>= 0.5 closed)";
-    return d;
-  }
+  py::dict action_space() const { return task_action_spec(n_); }
 
   py::dict observation_space() const {
     py::dict d;

@@ -20,7 +20,7 @@ TABLE = Section("The Python module and evaluate.py", """
 A bad argument to the `manisoft` module raises `ValueError` (a bad value: the argument, option or
 entry is named) or `RuntimeError` (a call out of order) and changes nothing: the environment steps
 on as if the call had not been made. `evaluate.py` exits 2 with one line naming the flag. `env` is
-`manisoft.make_env("COLL", "clean", seed=0, privileged=True)` after `env.reset(options={"index": 0})`,
+`manisoft.make_env("COLL", "clean", seed=0, render=False, privileged=True)` after `env.reset(options={"index": 0})`,
 `zero` its zero action, `vec` is `manisoft.make_vec_env("reach", 2)` after `vec.reset(seed=0)`.
 Test `python_bad_inputs` (`tests/python/test_bad_inputs.py`).
 """, ["call", "raises", "message"])
@@ -50,7 +50,7 @@ class BadInputs(unittest.TestCase):
         self.refused('make_env("COLL", "foggy")', lambda: manisoft.make_env("COLL", "foggy"), ValueError, "foggy")
         self.refused('make_env("COLL", camera={"zoom": 2})', lambda: manisoft.make_env("COLL", camera={"zoom": 2}), ValueError,
                      "camera: unknown key 'zoom'")
-        env = manisoft.make_env("COLL", "clean", seed=0, privileged=True)
+        env = manisoft.make_env("COLL", "clean", seed=0, render=False, privileged=True)
         zero = np.zeros(env.action_space.shape)
         self.refused("env.step(zero) before reset", lambda: env.step(zero), RuntimeError, "reset")
         env.reset(options={"index": 0})

@@ -62,8 +62,20 @@ class TaskEnvTest(unittest.TestCase):
         # Not a blank frame: the table, arm and objects give many distinct colours.
         self.assertGreater(len(np.unique(obs["image"].reshape(-1, 3), axis=0)), 50)
 
+    def test_the_default_observation_is_the_papers_image_and_instruction(self):
+        env = manisoft.make_env("ALN")  # clean, seed 0, the scene's camera: 514 x 514
+        obs, _ = env.reset(options={"index": 1})
+        self.assertEqual((obs["image"].shape, obs["image"].dtype), ((514, 514, 3), np.uint8))
+        self.assertEqual(obs["instruction"], "Place the shoe at the marker.")
+        self.assertNotIn("object_poses", obs)  # privileged state only on request
+        state = manisoft.make_env("ALN", render=False)
+        state_obs, _ = state.reset(options={"index": 1})
+        self.assertNotIn("image", state_obs)
+        self.assertEqual(state_obs["instruction"], obs["instruction"])
+        env.close()
+
     def test_expert_finishes_a_fixed_scene(self):
-        env = manisoft.make_env("ALN", "clean", seed=0)
+        env = manisoft.make_env("ALN", "clean", seed=0, render=False)
         obs, info = env.reset(options={"index": 1})
         rewards = []
         for _ in range(env.horizon):
@@ -84,7 +96,7 @@ class TaskEnvTest(unittest.TestCase):
             env.step(np.zeros(61))
 
     def test_zero_torques_time_out_at_the_horizon(self):
-        env = manisoft.make_env("ALN", "clean", seed=0)
+        env = manisoft.make_env("ALN", "clean", seed=0, render=False)
         env.reset(options={"index": 0})
         action = np.zeros(61)
         for step in range(1, 1501):
@@ -108,7 +120,7 @@ class TaskEnvTest(unittest.TestCase):
         self.assertEqual(manisoft.HORIZON, 1500)
         self.assertEqual(manisoft.CONTROL_DT, 7 * 2e-4)  # 7 substeps of 0.2 ms
         for t in tasks:
-            env = manisoft.make_env(t["name"], "clean", seed=0)
+            env = manisoft.make_env(t["name"], "clean", seed=0, render=False)
             _, info = env.reset(options={"index": 0})
             self.assertEqual(list(info["conditions"]), t["conditions"])
             self.assertEqual(env.horizon, manisoft.HORIZON)
@@ -122,7 +134,7 @@ class TaskEnvTest(unittest.TestCase):
             manisoft.make_env("PUSH")
 
     def test_same_seed_same_episode_and_actions_replay_bit_for_bit(self):
-        env = manisoft.make_env("ARR", "randomized", seed=4, privileged=True)
+        env = manisoft.make_env("ARR", "randomized", seed=4, render=False, privileged=True)
         env.reset(options={"index": 1})
         actions, states = [], []
         for _ in range(80):
@@ -130,13 +142,13 @@ class TaskEnvTest(unittest.TestCase):
             actions.append(a)
             obs, *_ = env.step(a)
             states.append(obs["rod_nodes"].copy())
-        other = manisoft.make_env("ARR", "randomized", seed=4, privileged=True)
+        other = manisoft.make_env("ARR", "randomized", seed=4, render=False, privileged=True)
         other.reset(options={"index": 1})
         for a, x in zip(actions, states):
             obs, *_ = other.step(a)
             self.assertTrue(np.array_equal(obs["rod_nodes"], x))
         # the same scene through its JSON text
-        third = manisoft.make_env("ARR", "randomized", seed=99, privileged=True)
+        third = manisoft.make_env("ARR", "randomized", seed=99, render=False, privileged=True)
         third.reset(options={"scene": env.scene_json()})
         self.assertTrue(np.array_equal(run(third, actions)["rod_nodes"], states[-1]))
 
@@ -150,7 +162,7 @@ class TaskEnvTest(unittest.TestCase):
         self.assertTrue(np.array_equal(env.render(), obs["image"]))
 
     def test_instructions_seen_and_unseen(self):
-        env = manisoft.make_env("COLL", "randomized", seed=0)
+        env = manisoft.make_env("COLL", "randomized", seed=0, render=False)
         scene = json.loads(manisoft.SceneSampler().sample("COLL", "randomized", 5, 0, "eval"))
         for kind in ("seen", "unseen"):
             self.assertTrue(scene["instructions_" + kind])  # randomized scenes have both kinds
@@ -161,7 +173,7 @@ class TaskEnvTest(unittest.TestCase):
         self.assertEqual(json.loads(env.scene_json())["split"], "eval")
 
     def test_bad_input_is_refused_and_changes_nothing(self):
-        env = manisoft.make_env("COLL", "clean", seed=0, privileged=True)
+        env = manisoft.make_env("COLL", "clean", seed=0, render=False, privileged=True)
         with self.assertRaisesRegex(RuntimeError, "reset"):
             env.step(np.zeros(61))
         env.reset(options={"index": 0})
@@ -180,7 +192,7 @@ class TaskEnvTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, r"\(S\) is not finite"):
             env.step(nan_s)
         obs, *_ = env.step(good)
-        fresh = manisoft.make_env("COLL", "clean", seed=0, privileged=True)
+        fresh = manisoft.make_env("COLL", "clean", seed=0, render=False, privileged=True)
         fresh.reset(options={"index": 0})
         expected, *_ = fresh.step(good)
         self.assertTrue(np.array_equal(obs["rod_nodes"], expected["rod_nodes"]))
@@ -212,7 +224,7 @@ class TaskEnvTest(unittest.TestCase):
             env.step(good)
 
     def test_bad_options_name_the_option_and_lists_are_actions(self):
-        env = manisoft.make_env("ALN", "clean", seed=0, privileged=True)
+        env = manisoft.make_env("ALN", "clean", seed=0, render=False, privileged=True)
         for options, pattern in [({"index": -1}, r"options\['index'\] must be an integer in \[0, 2\^64\), got -1$"),
                                  ({"index": "3"}, r"options\['index'\] .* got '3' \(str\)"),
                                  ({"index": 2.7}, r"options\['index'\] .* got 2.7$"),
@@ -226,7 +238,7 @@ class TaskEnvTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, r"reset: seed must be an integer in \[0, 2\^64\), got -1"):
             env.reset(seed=-1)
         obs, _ = env.reset(options={"index": 1})  # the refused calls changed nothing: index 1 of seed 0
-        reference = manisoft.make_env("ALN", "clean", seed=0, privileged=True)
+        reference = manisoft.make_env("ALN", "clean", seed=0, render=False, privileged=True)
         expected, _ = reference.reset(options={"index": 1})
         self.assertEqual(obs["instruction"], expected["instruction"])
         action = [0.0] * 61
