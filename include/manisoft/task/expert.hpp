@@ -87,6 +87,7 @@
 #include "manisoft/control/arm_observation.hpp"
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/core/error.hpp"
+#include "manisoft/geometry/box_overlap.hpp"
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/task/task_env.hpp"
 
@@ -694,7 +695,7 @@ class Expert {
   /// `ee`, comes within held_clearance of the bounding box of `asset` at `pose`.
   bool held_near(const Pose& ee, const Pose& pose, const assets::Asset& asset) const {
     return boxes_overlap(ee * held_in_ee_, asset_of(plan_object_), pose, asset, config_.held_clearance) ||
-           boxes_overlap(ee, gripper_center_, gripper_half_, pose, asset.bounding_center, asset.bounding_half_extents, config_.held_clearance);
+           geometry::boxes_overlap(ee, gripper_center_, gripper_half_, pose, asset.bounding_center, asset.bounding_half_extents, config_.held_clearance);
   }
   /// Checks plan p's carry leg on planner_ (check_leg) with the held object too (held_clear):
   /// the object at `object` when the end-effector is at `ee`, where the carry starts; what it is
@@ -721,27 +722,8 @@ class Expert {
   /// Whether the bounding boxes of assets a (at pose pa) and b (at pb) come within `margin` of
   /// each other: no separating axis among the 15 of two oriented boxes.
   static bool boxes_overlap(const Pose& pa, const assets::Asset& a, const Pose& pb, const assets::Asset& b, double margin) {
-    return boxes_overlap(pa, a.bounding_center, a.bounding_half_extents, pb, b.bounding_center, b.bounding_half_extents, margin);
+    return geometry::boxes_overlap(pa, a.bounding_center, a.bounding_half_extents, pb, b.bounding_center, b.bounding_half_extents, margin);
   }
-  /// The same for boxes of half extents ha (centre ca in frame pa) and hb (cb in pb).
-  static bool boxes_overlap(const Pose& pa, const Vec3& ca, const Vec3& ha, const Pose& pb, const Vec3& cb, const Vec3& hb, double margin) {
-    const Eigen::Matrix3d& ra = pa.rotation;
-    const Eigen::Matrix3d& rb = pb.rotation;
-    const Vec3 ea = ha + Vec3::Constant(0.5 * margin), eb = hb + Vec3::Constant(0.5 * margin);
-    const Vec3 d = pb.act(cb) - pa.act(ca);
-    auto separated = [&](const Vec3& axis) {
-      if (axis.squaredNorm() < 1e-12) return false;
-      const double ra_ = (ra.transpose() * axis).cwiseAbs().dot(ea), rb_ = (rb.transpose() * axis).cwiseAbs().dot(eb);
-      return std::abs(axis.dot(d)) > ra_ + rb_;
-    };
-    for (int i = 0; i < 3; ++i)
-      if (separated(ra.col(i)) || separated(rb.col(i))) return false;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        if (separated(ra.col(i).cross(rb.col(j)))) return false;
-    return true;
-  }
-
   /// Checks a ramp to `to` on planner_ (the cold inverse statics solution within the limits and
   /// clear of the table) and jumps to its end; false (the planner as before) otherwise.
   bool check_ramp(const Pose& to) {
