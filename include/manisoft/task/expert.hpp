@@ -226,7 +226,7 @@ class Expert {
     lower_fast_ = false;
     steps_ = 0;
     events_.clear();
-    failure_ = nullptr;
+    failure_.reset();
     moves_ = count_moves();
     begin_move();
   }
@@ -245,8 +245,9 @@ class Expert {
   ExpertPhase phase() const { return phase_; }
   int move() const { return move_; }
   int moves() const { return moves_; }
-  /// Why the expert gave up ("" while it has not): a path the executor refused, a missed grasp.
-  const char* failure() const { return failure_ ? failure_ : ""; }
+  /// Why the expert gave up (none while it has not): a path the executor refused, a missed grasp.
+  /// The text lives as long as the expert, until its next reset().
+  std::optional<std::string_view> failure() const { return failure_; }
   const std::vector<ExpertEvent>& events() const { return events_; }
   const Executor& executor() const { return executor_; }
 
@@ -758,7 +759,7 @@ class Expert {
     }
     if (!plan_move(move_)) {
       plan_refusal_ = "no feasible grasp (the least-turning one: " + plan_refusal_ + ")";
-      give_up(plan_refusal_.c_str());
+      give_up(plan_refusal_);
       return;
     }
     leg_ = 0;
@@ -799,7 +800,7 @@ class Expert {
     return false;
   }
 
-  void give_up(const char* why) {
+  void give_up(std::string_view why) {
     failure_ = why;
     enter(ExpertPhase::failed);
   }
@@ -1102,7 +1103,7 @@ class Expert {
   std::vector<Pose> excluded_;  ///< grasps (in the object's frame) re-tries of this move leave out
   long steps_ = 0;
   std::vector<ExpertEvent> events_;
-  const char* failure_ = nullptr;
+  std::optional<std::string_view> failure_;
   std::string plan_refusal_;  ///< why the least-turning grasp candidate was refused
   bool repair_ = true;        ///< check_leg may repair refused lines
   bool touched_ = false;      ///< the lower phase found the object supported
