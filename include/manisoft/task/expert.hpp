@@ -543,19 +543,43 @@ class Expert {
   /// Angle between an end-effector orientation and the home one.
   double turn_from_home(const Pose& p) const { return Eigen::AngleAxisd(p.rotation * env_->home_pose().rotation.transpose()).angle(); }
 
+  /// A grasp candidate of a move and its cost (least turning first, then the fewest lines).
+  struct Candidate {
+    double cost;
+    Plan plan;
+  };
+
   /// The grasp of move k: the feasible candidate that turns least (see the header comment).
   bool plan_move(int k) {
     const auto [object, target] = move_goal(k);
+    const std::vector<Candidate> candidates = grasp_candidates(object, target);
+    plan_refusal_ = candidates.empty() ? "the asset has no grasp annotation" : "";
+    // first pass: straight lines only; second: refused lines repaired (check_leg)
+    plan_object_ = object;
+    for (int pass = 0; pass < 2; ++pass) {
+      repair_ = pass == 1;
+      // (a re-try, whose first grasp failed, searches straight lines only: the repair pass checks
+      // every candidate again, about 0.5 s when none passes)
+      if (repair_ && (!config_.ramp_fallback || retries_ > 0)) break;
+      for (auto c : candidates) {
+        if (check_candidate(c.plan, k)) {
+          plan_ = c.plan;
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+
+  /// Every grasp candidate of putting `object` at `target`, cheapest first: each annotated grasp
+  /// turned about the object's axis as its symmetry allows (round: eighth turns, square: quarter
+  /// turns) and half a turn about the fingers' axis (the parallel gripper), each with seven leg
+  /// variants; grasps a re-try left out are not among them.
+  std::vector<Candidate> grasp_candidates(int object, const Pose& target) const {
     const auto& a = asset_of(object);
     const Pose now = state_of(object).pose;
-    struct Candidate {
-      double cost;
-      Plan plan;
-    };
     std::vector<Candidate> candidates;
     const Pose from = executor_.statics().desired_tip_pose();
-    // the object's symmetry turns a grasp about the object's axis (round: eighth turns, square:
-    // quarter turns); the parallel gripper's turns it half a turn about the fingers' axis
     const scene::Symmetry sym = scene::asset_symmetry(a);
     const int object_turns = sym.kind == scene::Symmetry::Kind::axial ? 8 : sym.kind == scene::Symmetry::Kind::discrete ? std::max(1, sym.order) : 1;
     for (const auto& g : a.grasps) {
@@ -589,35 +613,29 @@ class Expert {
       }
     }
     std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
-    plan_refusal_ = candidates.empty() ? "the asset has no grasp annotation" : "";
-    // first pass: straight lines only; second: refused lines repaired (check_leg)
-    plan_object_ = object;
-    for (int pass = 0; pass < 2; ++pass) {
-    repair_ = pass == 1;
-    // (a re-try, whose first grasp failed, searches straight lines only: the repair pass checks
-    // every candidate again, about 0.5 s when none passes)
-    if (repair_ && (!config_.ramp_fallback || retries_ > 0)) break;
-    for (auto c : candidates) {
-      planner_ = executor_;
-      planner_.complete_path();
-      const char* why = "";
-      const char* where = "";
-      bool ok = check_leg(c.plan.approach_leg, why);
-      if (!ok) where = "approach";
-      if (ok && !(ok = check_line(c.plan.grasp, why))) where = "grasp";
-      if (ok) {
-        planner_.set_payload(a.mass, c.plan.grasp.rotation.transpose() * (now.act(a.center_of_mass) - c.plan.grasp.translation));
-        if (!(ok = check_carry_leg(c.plan, c.plan.grasp, now, support_of(k), why))) where = "carry";
-      }
-      if (ok && !(ok = check_line(c.plan.place, why))) where = "place";
-      if (ok) {
-        plan_ = c.plan;
-        return true;
-      }
-      if (plan_refusal_.empty()) plan_refusal_ = std::string(where) + ": " + why;
+    return candidates;
+  }
+
+  /// Checks candidate plan p of move k on planner_ from the executor's shape target: approach,
+  /// grasp, carry (holding the object), place. False (the first refusal noted in plan_refusal_)
+  /// when a line is refused.
+  bool check_candidate(Plan& p, int k) {
+    const auto& a = asset_of(p.object);
+    const Pose now = state_of(p.object).pose;
+    planner_ = executor_;
+    planner_.complete_path();
+    const char* why = "";
+    const char* where = "";
+    bool ok = check_leg(p.approach_leg, why);
+    if (!ok) where = "approach";
+    if (ok && !(ok = check_line(p.grasp, why))) where = "grasp";
+    if (ok) {
+      planner_.set_payload(a.mass, p.grasp.rotation.transpose() * (now.act(a.center_of_mass) - p.grasp.translation));
+      if (!(ok = check_carry_leg(p, p.grasp, now, support_of(k), why))) where = "carry";
     }
-    }
-    return false;
+    if (ok && !(ok = check_line(p.place, why))) where = "place";
+    if (!ok && plan_refusal_.empty()) plan_refusal_ = std::string(where) + ": " + why;
+    return ok;
   }
 
   /// Tracks one line to `to` on planner_ (from its shape target) and jumps to its end; false
@@ -923,8 +941,18 @@ class Expert {
   /// via_error at an arc or via point, start_error at the leg's last pose.
   double chain_error(const Leg& leg) const { return leg_ + 1 < leg.count ? config_.via_error : config_.start_error; }
 
-  /// The phase machine, after the last control step.
-  void advance(const TaskEnv::World& w) {
+  /// What the phase handlers read of the world after a control step.
+  struct Tick {
+    const TaskEnv::World& world;
+    Pose ee;         ///< the end-effector frame
+    double error;    ///< m: the end-effector from its target
+    double speed;    ///< m/s: the arm's tip
+    bool done;       ///< the executor's path is complete
+    bool settled;    ///< done, slower than settle_speed and within settle_error
+    bool holding;    ///< the gripper holds the moved object
+  };
+
+  Tick observe_tick(const TaskEnv::World& w) const {
     const auto f = w.soft().end_effector_frame();
     const double error = (f.position - target_.translation).norm();
     const auto& v = w.rod().state().velocities;
@@ -933,156 +961,189 @@ class Expert {
     const bool settled = done && speed < config_.settle_speed && error < config_.settle_error;
     const auto held = w.gripper().held();
     const bool holding = held && plan_.object >= 0 && *held == env_->bodies().objects[static_cast<std::size_t>(plan_.object)];
+    return Tick{w, Pose{f.rotation, f.position}, error, speed, done, settled, holding};
+  }
+
+  /// The phase machine, after the last control step: one handler per phase.
+  void advance(const TaskEnv::World& w) {
+    const Tick t = observe_tick(w);
     switch (phase_) {
-      case ExpertPhase::approach:
-        if (done && error < chain_error(plan_.approach_leg)) {
-          if (leg_ + 1 < plan_.approach_leg.count) {
-            start_leg(plan_.approach_leg, ++leg_);
-          } else {
-            enter(ExpertPhase::descend);
-            start_path(plan_.grasp, true, tight_grasp() ? config_.tight_peak_speed : 0.0);
-          }
-        }
-        break;
-      case ExpertPhase::descend:
-        if (done && (settled || ++waited_ > config_.max_settle_steps)) {
-          waited_ = 0;
-          // blocked short of the grasp (a finger on the object): the hand would close around
-          // the object askew, and its carry is then mostly beyond the actuation limits
-          if (error > config_.grasp_error && retry_with_another_grasp()) break;
-          s_ = 1;
-          enter(ExpertPhase::close);
-        }
-        break;
-      case ExpertPhase::close: {
-        if (!holding && w.gripper().closing()) break;  // the fingers are still on their way
-        if (!holding) {
-          s_ = 0;
-          if (retries_++ < config_.max_retries) {
-            begin_move();
-          } else {
-            give_up("missed grasp");
-          }
-          break;
-        }
-        bool carriable = false;
-        // Where the object sits in the hand: the payload hint and the place correction.
-        const Pose ee{f.rotation, f.position};
-        const Pose object = state_of(plan_.object).pose;
-        const auto& a = asset_of(plan_.object);
-        executor_.set_payload(a.mass, ee.rotation.transpose() * (object.act(a.center_of_mass) - ee.translation));
-        {
-          // the object's target orientation nearest the one this grasp would release it in
-          const Eigen::Matrix3d would_be = (plan_.place * ee.inverse() * object).rotation;
-          const auto symmetry = yaw_free(plan_.object) ? scene::Symmetry{scene::Symmetry::Kind::axial, 0} : scene::asset_symmetry(a);
-          plan_.object_target.rotation = nearest_equivalent(would_be, plan_.object_target.rotation, symmetry);
-        }
-        plan_.place = plan_.object_target * object.inverse() * ee;
-        set_carry_leg(plan_);
-        // the corrected carry, checked (and repaired) from here; when it is refused, the other
-        // kind (direct or via the lift); when both are, the planned one as corrected
-        for (const bool via : {plan_.via_carry, !plan_.via_carry}) {
-          Plan checked = plan_;
-          checked.via_carry = via;
-          set_carry_leg(checked);
-          repair_ = true;
-          planner_ = executor_;
-          planner_.complete_path();
-          const char* why = "";
-          if (check_carry_leg(checked, ee, object, support_of(move_), why) && check_line(checked.place, why)) {
-            plan_ = checked;
-            carriable = true;
-            break;
-          }
-        }
-        // neither carry passes from where the object sits in the hand: put it back (it still
-        // stands where it was grasped) and re-try with another grasp
-        if (!carriable && retries_ < config_.max_retries) {
-          executor_.set_payload(0.0);
-          retry_with_another_grasp();
-          break;
-        }
-        leg_ = 0;
-        enter(ExpertPhase::carry);
-        start_leg(plan_.carry_leg, 0);
-        break;
-      }
-      case ExpertPhase::carry:
-        if (!holding) {
-          give_up("dropped the object");
-          break;
-        }
-        if (done && error < chain_error(plan_.carry_leg)) {
-          if (leg_ + 1 < plan_.carry_leg.count) {
-            start_leg(plan_.carry_leg, ++leg_);
-          } else if (!(config_.carry_settle_speed > 0) || speed < config_.carry_settle_speed || ++waited_ > config_.max_settle_steps) {
-            waited_ = 0;
-            enter(ExpertPhase::lower);
-            // a long lower (into a container) runs at the carry's speed to slow_lower above its end first
-            Pose fast = lower_goal();
-            fast.translation.z() += config_.slow_lower;
-            lower_fast_ = config_.slow_lower > 0 && target_.translation.z() - fast.translation.z() > config_.slow_lower;
-            start_path(lower_fast_ ? fast : lower_goal(), true, lower_fast_ ? 0.0 : config_.lower_peak_speed);
-          }
-        }
-        break;
-      case ExpertPhase::lower:
-        if (!holding) {
-          give_up("dropped the object");
-          break;
-        }
-        if (lower_fast_ && !supported(state_of(plan_.object))) {
-          if (done && error < config_.start_error) {
-            lower_fast_ = false;
-            // refused: the object is slow_lower above its release height already (into a
-            // container: mostly below the rim), so it is let go from here once settled
-            start_path(lower_goal(), false, config_.lower_peak_speed);
-          }
-          break;
-        }
-        lower_fast_ = false;
-        // Its support already carries the object (it touches the table or another object, or
-        // sank half the clearance below the release height): open now rather than press it in
-        // until it slips.
-        // With release_settle_speed, the arm stops where it is first and opens once its tip is
-        // slower (a tall object let go while the arm still sways tips over).
-        if (!touched_ && (supported(state_of(plan_.object)) || fingers_blocked(w))) {
-          touched_ = true;
-          waited_ = 0;
-          if (release_settles()) {
-            Pose hold{f.rotation, f.position};  // where the arm is, lifted so it does not press on
-            hold.translation.z() += config_.release_lift;
-            start_path(hold, false);
-          }
-        }
-        if (touched_ ? (!release_settles() || speed < config_.release_settle_speed || ++waited_ > config_.max_settle_steps)
-                     : (done && (settled || ++waited_ > config_.max_settle_steps))) {
-          touched_ = false;
-          waited_ = 0;
-          s_ = 0;
-          executor_.set_payload(0.0);
-          enter(ExpertPhase::open);
-        }
-        break;
-      case ExpertPhase::open:
-        if (is_tall(plan_.object) && w.gripper().opening() && w.gripper().finger_width() < plan_.width + 2 * config_.release_clearance) break;
-        // Up and away from the released object, also after the last move (fingers left
-        // around it keep pushing it as the arm sways, and it never comes to rest).
-        ++move_;
-        retries_ = 0;
-        excluded_.clear();
-        enter(ExpertPhase::retract);
-        // a refused retract is not a failure: the next move plans from here, or the arm holds
-        if (!start_path(retract_pose(), false, config_.retract_peak_speed)) {
-          if (move_ < moves_) begin_move();
-          else enter(ExpertPhase::idle);
-        }
-        break;
+      case ExpertPhase::approach: advance_approach(t); break;
+      case ExpertPhase::descend: advance_descend(t); break;
+      case ExpertPhase::close: advance_close(t); break;
+      case ExpertPhase::carry: advance_carry(t); break;
+      case ExpertPhase::lower: advance_lower(t); break;
+      case ExpertPhase::open: advance_open(t); break;
       case ExpertPhase::retract:
-        if (done && error < config_.start_error) begin_move();
+        if (t.done && t.error < config_.start_error) begin_move();
         break;
       case ExpertPhase::idle:
       case ExpertPhase::failed: break;
+    }
+  }
+
+  /// Approach: the approach leg's lines in turn, then the descent to the grasp.
+  void advance_approach(const Tick& t) {
+    if (!(t.done && t.error < chain_error(plan_.approach_leg))) return;
+    if (leg_ + 1 < plan_.approach_leg.count) {
+      start_leg(plan_.approach_leg, ++leg_);
+      return;
+    }
+    enter(ExpertPhase::descend);
+    start_path(plan_.grasp, true, tight_grasp() ? config_.tight_peak_speed : 0.0);
+  }
+
+  /// Descend: at the grasp once settled, close.
+  void advance_descend(const Tick& t) {
+    if (!(t.done && (t.settled || ++waited_ > config_.max_settle_steps))) return;
+    waited_ = 0;
+    // blocked short of the grasp (a finger on the object): the hand would close around
+    // the object askew, and its carry is then mostly beyond the actuation limits
+    if (t.error > config_.grasp_error && retry_with_another_grasp()) return;
+    s_ = 1;
+    enter(ExpertPhase::close);
+  }
+
+  /// Close: once the object is held, the place corrected for where it sits in the hand and the
+  /// carry checked from there; a missed grasp re-tries the move.
+  void advance_close(const Tick& t) {
+    if (!t.holding && t.world.gripper().closing()) return;  // the fingers are still on their way
+    if (!t.holding) {
+      s_ = 0;
+      if (retries_++ < config_.max_retries) {
+        begin_move();
+      } else {
+        give_up("missed grasp");
+      }
+      return;
+    }
+    const Pose object = state_of(plan_.object).pose;
+    correct_place(t.ee, object);
+    // neither carry passes from where the object sits in the hand: put it back (it still
+    // stands where it was grasped) and re-try with another grasp
+    if (!recheck_carry(t.ee, object) && retries_ < config_.max_retries) {
+      executor_.set_payload(0.0);
+      retry_with_another_grasp();
+      return;
+    }
+    leg_ = 0;
+    enter(ExpertPhase::carry);
+    start_leg(plan_.carry_leg, 0);
+  }
+
+  /// Where the object sits in the hand (end-effector at `ee`, the object at `object`): the
+  /// payload hint, the target orientation nearest the one this grasp releases it in, the place
+  /// pose and the carry leg from there.
+  void correct_place(const Pose& ee, const Pose& object) {
+    const auto& a = asset_of(plan_.object);
+    executor_.set_payload(a.mass, ee.rotation.transpose() * (object.act(a.center_of_mass) - ee.translation));
+    {
+      // the object's target orientation nearest the one this grasp would release it in
+      const Eigen::Matrix3d would_be = (plan_.place * ee.inverse() * object).rotation;
+      const auto symmetry = yaw_free(plan_.object) ? scene::Symmetry{scene::Symmetry::Kind::axial, 0} : scene::asset_symmetry(a);
+      plan_.object_target.rotation = nearest_equivalent(would_be, plan_.object_target.rotation, symmetry);
+    }
+    plan_.place = plan_.object_target * object.inverse() * ee;
+    set_carry_leg(plan_);
+  }
+
+  /// The corrected carry, checked (and repaired) from here; when it is refused, the other kind
+  /// (direct or via the lift). True (plan_ takes the carry that passed) when one passes; false
+  /// (plan_ keeps the planned kind as corrected) when both are refused.
+  bool recheck_carry(const Pose& ee, const Pose& object) {
+    for (const bool via : {plan_.via_carry, !plan_.via_carry}) {
+      Plan checked = plan_;
+      checked.via_carry = via;
+      set_carry_leg(checked);
+      repair_ = true;
+      planner_ = executor_;
+      planner_.complete_path();
+      const char* why = "";
+      if (check_carry_leg(checked, ee, object, support_of(move_), why) && check_line(checked.place, why)) {
+        plan_ = checked;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// Carry: the carry leg's lines in turn, then (once the arm's tip is slower than
+  /// carry_settle_speed) the lower.
+  void advance_carry(const Tick& t) {
+    if (!t.holding) {
+      give_up("dropped the object");
+      return;
+    }
+    if (!(t.done && t.error < chain_error(plan_.carry_leg))) return;
+    if (leg_ + 1 < plan_.carry_leg.count) {
+      start_leg(plan_.carry_leg, ++leg_);
+    } else if (!(config_.carry_settle_speed > 0) || t.speed < config_.carry_settle_speed || ++waited_ > config_.max_settle_steps) {
+      waited_ = 0;
+      enter(ExpertPhase::lower);
+      // a long lower (into a container) runs at the carry's speed to slow_lower above its end first
+      Pose fast = lower_goal();
+      fast.translation.z() += config_.slow_lower;
+      lower_fast_ = config_.slow_lower > 0 && target_.translation.z() - fast.translation.z() > config_.slow_lower;
+      start_path(lower_fast_ ? fast : lower_goal(), true, lower_fast_ ? 0.0 : config_.lower_peak_speed);
+    }
+  }
+
+  /// Lower: the fast line first (slow_lower), then the slow one; open once the object is
+  /// supported (or the fingers blocked) or the lower settled.
+  void advance_lower(const Tick& t) {
+    if (!t.holding) {
+      give_up("dropped the object");
+      return;
+    }
+    if (lower_fast_ && !supported(state_of(plan_.object))) {
+      if (t.done && t.error < config_.start_error) {
+        lower_fast_ = false;
+        // refused: the object is slow_lower above its release height already (into a
+        // container: mostly below the rim), so it is let go from here once settled
+        start_path(lower_goal(), false, config_.lower_peak_speed);
+      }
+      return;
+    }
+    lower_fast_ = false;
+    // Its support already carries the object (it touches the table or another object, or
+    // sank half the clearance below the release height): open now rather than press it in
+    // until it slips.
+    // With release_settle_speed, the arm stops where it is first and opens once its tip is
+    // slower (a tall object let go while the arm still sways tips over).
+    if (!touched_ && (supported(state_of(plan_.object)) || fingers_blocked(t.world))) {
+      touched_ = true;
+      waited_ = 0;
+      if (release_settles()) {
+        Pose hold = t.ee;  // where the arm is, lifted so it does not press on
+        hold.translation.z() += config_.release_lift;
+        start_path(hold, false);
+      }
+    }
+    if (touched_ ? (!release_settles() || t.speed < config_.release_settle_speed || ++waited_ > config_.max_settle_steps)
+                 : (t.done && (t.settled || ++waited_ > config_.max_settle_steps))) {
+      touched_ = false;
+      waited_ = 0;
+      s_ = 0;
+      executor_.set_payload(0.0);
+      enter(ExpertPhase::open);
+    }
+  }
+
+  /// Open: once the opening fingers clear a tall object (release_clearance), the retract; the
+  /// next move starts from there.
+  void advance_open(const Tick& t) {
+    const auto& g = t.world.gripper();
+    if (is_tall(plan_.object) && g.opening() && g.finger_width() < plan_.width + 2 * config_.release_clearance) return;
+    // Up and away from the released object, also after the last move (fingers left
+    // around it keep pushing it as the arm sways, and it never comes to rest).
+    ++move_;
+    retries_ = 0;
+    excluded_.clear();
+    enter(ExpertPhase::retract);
+    // a refused retract is not a failure: the next move plans from here, or the arm holds
+    if (!start_path(retract_pose(), false, config_.retract_peak_speed)) {
+      if (move_ < moves_) begin_move();
+      else enter(ExpertPhase::idle);
     }
   }
 
