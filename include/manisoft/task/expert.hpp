@@ -844,14 +844,10 @@ class Expert {
   /// object `held`, also within carry_grip_share of what the grip holds.
   int line_steps(double distance, bool loaded, double peak_speed, int held) const {
     const double peak = peak_speed > 0 ? peak_speed : loaded ? config_.carry_peak_speed : config_.path_peak_speed;
-    // peak speed / mean speed of the timing
-    const double peak_ratio = config_.path_cruise > 0 ? 2 / (1 + config_.path_cruise) : 1.875;
-    double seconds = peak_ratio * distance / peak;
+    double seconds = Executor::peak_speed_ratio(config_.path_cruise) * distance / peak;
     if (loaded && config_.carry_grip_share > 0 && held >= 0) {
-      // peak acceleration of the timing: 6 d / (T^2 (1 - c^2)) with a cruise c (smoothstep speed
-      // ramps over (1 - c) T / 2 at each end), 5.77 d / T^2 quintic
-      const double c = config_.path_cruise;
-      const double shape = c > 0 ? 6 / (1 - c * c) : 5.7735;
+      // the timing's peak acceleration is shape x distance / T^2
+      const double shape = Executor::peak_acceleration_ratio(config_.path_cruise);
       const double accel = config_.carry_grip_share * env_->gripper_parameters().max_hold_force / asset_of(held).mass;
       seconds = std::max(seconds, std::sqrt(shape * distance / accel));
     }
