@@ -89,6 +89,8 @@
 #include "manisoft/core/error.hpp"
 #include "manisoft/geometry/box_overlap.hpp"
 #include "manisoft/scene/asset_library.hpp"
+#include "manisoft/task/moves.hpp"
+#include "manisoft/task/registry.hpp"
 #include "manisoft/task/task_env.hpp"
 
 namespace manisoft::task {
@@ -370,20 +372,20 @@ class Expert {
     return true;
   }
 
-  /// COLL: the object is released low in the container (its bottom place_clearance above the
-  /// floor) rather than dropped from above the rim (a tall one dropped inner_depth rocks on in
-  /// the container for seconds), as far as the fingertips stay finger_clearance above the rim,
-  /// or down to the floor when the open gripper fits into the opening (a basket).
-  /// move_goal() puts the object's bottom place_clearance above the rim; this lowers it.
-  void sink_into_container(Plan& p) const {
-    const auto& s = env_->spec();
-    if (s.task != scene::Task::coll) return;
-    const auto& rc = asset_of(s.goal.container).receptacles.at(0);
+  /// Into a container (SupportKind::into: COLL): the object is released low in the container
+  /// (its bottom place_clearance above the floor) rather than dropped from above the rim (a tall
+  /// one dropped inner_depth rocks on in the container for seconds), as far as the fingertips
+  /// stay finger_clearance above the rim, or down to the floor when the open gripper fits into
+  /// the opening (a basket). move_goal() puts the object's bottom place_clearance above the rim;
+  /// this lowers it.
+  void sink_into_container(Plan& p, const Support& support) const {
+    if (support.kind != SupportKind::into) return;
+    const auto& rc = asset_of(support.object).receptacles.at(0);
     // A container whose opening the open gripper fits into (finger_clearance to spare, at any
     // yaw): the object goes down to its floor.
     const double reach = std::hypot(gripper_half_.x(), gripper_half_.y());
     const double room = rc.inner_radius > 0 ? rc.inner_radius : rc.inner_half_extents.minCoeff();
-    const double rim = (state_of(s.goal.container).pose * rc.opening).translation.z();
+    const double rim = (state_of(support.object).pose * rc.opening).translation.z();
     p.sink = room >= reach + config_.finger_clearance ? rc.inner_depth
                                                         : std::clamp(fingertips(p.place).z() - (rim + config_.finger_clearance), 0.0, rc.inner_depth);
     p.place.translation.z() -= p.sink;
@@ -441,18 +443,7 @@ class Expert {
 
   int count_moves() const {
     const auto& s = env_->spec();
-    switch (s.task) {
-      case scene::Task::coll:
-      case scene::Task::aln:
-      case scene::Task::ovr: return 1;
-      case scene::Task::stk: return static_cast<int>(s.goal.items.size()) - 1;
-      case scene::Task::arr: {
-        int n = 0;
-        for (const auto& r : s.goal.relations) n += static_cast<int>(r.spots.size());
-        return n;
-      }
-    }
-    return 0;
+    return visit_task(s.task, [&s]<TaskType T>(T) { return T::moves(s); });
   }
 
   const assets::Asset& asset_of(int object) const {
@@ -460,84 +451,25 @@ class Expert {
   }
   const ObjectState& state_of(int object) const { return env_->snapshot().objects[static_cast<std::size_t>(object)]; }
 
-  /// Move k: which object goes where (read from the current state).
-  std::pair<int, Pose> move_goal(int k) const {
-    const auto& s = env_->spec();
-    const double top = s.table.top_center.z();
-    switch (s.task) {
-      case scene::Task::coll: {
-        const Pose container = state_of(s.goal.container).pose;
-        const auto& rc = asset_of(s.goal.container).receptacles.at(0);
-        const Pose opening = container * rc.opening, placement = container * rc.placement;
-        Pose p = state_of(s.goal.object).pose;
-        p.translation = Vec3(placement.translation.x(), placement.translation.y(), opening.translation.z() + config_.place_clearance);
-        return {s.goal.object, p};
-      }
-      case scene::Task::aln: {
-        const Pose now = state_of(s.goal.object).pose;
-        Pose p = s.goal.goal_pose;
-        p.translation.z() += config_.place_clearance;
-        p.rotation = nearest_equivalent(now.rotation, p.rotation, s.goal.symmetry);
-        return {s.goal.object, p};
-      }
-      case scene::Task::ovr: {
-        Pose p = state_of(s.goal.object).pose;
-        p.translation = s.goal.goal_pose.translation + Vec3(0, 0, config_.place_clearance);
-        return {s.goal.object, p};
-      }
-      case scene::Task::stk: {
-        const int below = s.goal.items.at(static_cast<std::size_t>(k)), item = s.goal.items.at(static_cast<std::size_t>(k) + 1);
-        const Pose b = state_of(below).pose;
-        const auto& ab = asset_of(below);
-        Pose p = state_of(item).pose;
-        const Vec3 on = ab.receptacles.empty() ? Vec3(b.translation + Vec3(0, 0, scene::asset_height(ab))) : Vec3((b * ab.receptacles.front().placement).translation);
-        p.translation = on + Vec3(0, 0, config_.place_clearance);
-        return {item, p};
-      }
-      case scene::Task::arr: {
-        int n = 0;
-        for (const auto& r : s.goal.relations)
-          for (std::size_t j = 0; j < r.spots.size(); ++j, ++n)
-            if (n == k) {
-              const int o = r.objects.at(j);
-              Pose p = state_of(o).pose;
-              p.translation = Vec3(r.spots[j].x(), r.spots[j].y(), top + (p.translation.z() - top) + config_.place_clearance);
-              return {o, p};
-            }
-        break;
-      }
-    }
-    manisoft::detail::fail("Expert: no move ", k);
+  /// Move k: which object goes where (read from the current state; the task type's move()).
+  Move move_goal(int k) const {
+    const Snapshot snapshot = env_->snapshot();
+    const MoveScene scene{env_->spec(), env_->library(), snapshot, config_.place_clearance};
+    return visit_task(env_->spec().task, [&]<TaskType T>(T) { return T::move(k, scene); });
   }
 
   /// What move k puts its object into or onto (COLL: the container, STK: the item below; -1: the
   /// table): the carry keeps clear of it until it lowers the object.
-  int support_of(int k) const {
+  Support support_of(int k) const {
     const auto& s = env_->spec();
-    if (s.task == scene::Task::coll) return s.goal.container;
-    if (s.task == scene::Task::stk) return s.goal.items.at(static_cast<std::size_t>(k));
-    return -1;
-  }
-
-  /// The goal orientation's symmetric equivalent that turns least from `now` (about world z).
-  static Eigen::Matrix3d nearest_equivalent(const Eigen::Matrix3d& now, const Eigen::Matrix3d& goal, const scene::Symmetry& sym) {
-    if (sym.kind == scene::Symmetry::Kind::axial)  // only the axis matters: `now` turned least to the goal's axis
-      return Eigen::Quaterniond::FromTwoVectors(now.col(2), goal.col(2)).toRotationMatrix() * now;
-    const int n = sym.kind == scene::Symmetry::Kind::discrete ? std::max(1, sym.order) : 1;
-    Eigen::Matrix3d best = goal;
-    double best_angle = 10;
-    for (int k = 0; k < n; ++k) {
-      const Eigen::Matrix3d g = goal * Eigen::AngleAxisd(2 * std::numbers::pi * k / n, Vec3::UnitZ()).toRotationMatrix();
-      const double a = Eigen::AngleAxisd(g * now.transpose()).angle();
-      if (a < best_angle) best_angle = a, best = g;
-    }
-    return best;
+    return visit_task(s.task, [&]<TaskType T>(T) { return T::support(k, s); });
   }
 
   /// Whether the yaw of the object's target pose is free: the object is round, or the task
-  /// (all but ALN) states no orientation.
+  /// states no orientation (states_yaw).
   bool yaw_free(int object) const {
-    return env_->spec().task != scene::Task::aln || scene::asset_symmetry(asset_of(object)).kind == scene::Symmetry::Kind::axial;
+    const bool states_yaw = visit_task(env_->spec().task, []<TaskType T>(T) { return T::states_yaw; });
+    return !states_yaw || scene::asset_symmetry(asset_of(object)).kind == scene::Symmetry::Kind::axial;
   }
 
   /// Angle between an end-effector orientation and the home one.
@@ -552,7 +484,7 @@ class Expert {
   /// The grasp of move k: the feasible candidate that turns least (see the header comment).
   bool plan_move(int k) {
     const auto [object, target] = move_goal(k);
-    const std::vector<Candidate> candidates = grasp_candidates(object, target);
+    const std::vector<Candidate> candidates = grasp_candidates(object, target, support_of(k));
     plan_refusal_ = candidates.empty() ? "the asset has no grasp annotation" : "";
     // first pass: straight lines only; second: refused lines repaired (check_leg)
     plan_object_ = object;
@@ -575,7 +507,7 @@ class Expert {
   /// turned about the object's axis as its symmetry allows (round: eighth turns, square: quarter
   /// turns) and half a turn about the fingers' axis (the parallel gripper), each with seven leg
   /// variants; grasps a re-try left out are not among them.
-  std::vector<Candidate> grasp_candidates(int object, const Pose& target) const {
+  std::vector<Candidate> grasp_candidates(int object, const Pose& target, const Support& support) const {
     const auto& a = asset_of(object);
     const Pose now = state_of(object).pose;
     std::vector<Candidate> candidates;
@@ -598,7 +530,7 @@ class Expert {
             p.grasp = now * about_axis * g.grasp * half;
             if (excluded(now, p.grasp)) continue;
             p.place = target * now.inverse() * p.grasp;
-            sink_into_container(p);
+            sink_into_container(p, support);
             p.via_approach = variant & 1;
             p.via_carry = variant & 2;
             p.raise = variant & 4 ? config_.via_raise : 0.0;
@@ -631,7 +563,7 @@ class Expert {
     if (ok && !(ok = check_line(p.grasp, why))) where = "grasp";
     if (ok) {
       planner_.set_payload(a.mass, p.grasp.rotation.transpose() * (now.act(a.center_of_mass) - p.grasp.translation));
-      if (!(ok = check_carry_leg(p, p.grasp, now, support_of(k), why))) where = "carry";
+      if (!(ok = check_carry_leg(p, p.grasp, now, support_of(k).object, why))) where = "carry";
     }
     if (ok && !(ok = check_line(p.place, why))) where = "place";
     if (!ok && plan_refusal_.empty()) plan_refusal_ = std::string(where) + ": " + why;
@@ -888,14 +820,14 @@ class Expert {
 
   /// The end of the lower line: the place pose; for a tall object (release_settles()) lowered
   /// on by place_clearance + contact_depth, so that it reaches its support and is not dropped.
-  /// STK: no lower than where the fingertips are stack_finger_clearance above the item below's
+  /// Onto an item (SupportKind::onto: STK): no lower than where the fingertips are stack_finger_clearance above the item below's
   /// top (the closed fingers, at the held item's width, would land on its rim or inner wall
   /// before the held item nests); the item drops the rest of the way.
   Pose lower_goal() const {
     Pose p = plan_.place;
     if (release_settles() && config_.contact_depth > 0) p.translation.z() -= config_.place_clearance + config_.contact_depth;
-    if (env_->spec().task == scene::Task::stk) {
-      const double lowest = top_of(support_of(move_)) + config_.stack_finger_clearance;
+    if (const Support below = support_of(move_); below.kind == SupportKind::onto) {
+      const double lowest = top_of(below.object) + config_.stack_finger_clearance;
       p.translation.z() += std::max(0.0, lowest - fingertips(p).z());
     }
     return p;
@@ -1055,7 +987,7 @@ class Expert {
       planner_ = executor_;
       planner_.complete_path();
       const char* why = "";
-      if (check_carry_leg(checked, ee, object, support_of(move_), why) && check_line(checked.place, why)) {
+      if (check_carry_leg(checked, ee, object, support_of(move_).object, why) && check_line(checked.place, why)) {
         plan_ = checked;
         return true;
       }
