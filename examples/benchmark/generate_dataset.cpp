@@ -105,7 +105,7 @@ class Worker {
       int s = 0;
       // A draw ends when the episode does or when the expert gives up: an episode it no longer
       // drives is not kept, so its remaining steps until the horizon would be spent for nothing.
-      while (!env_.done() && !expert_.failure()[0]) {
+      while (!env_.done() && !expert_.failure()) {
         expert_.act(torques, s);
         recorder.step(torques, s);
         env_.step(torques, s);
@@ -116,7 +116,7 @@ class Worker {
         if (plan_.image_every > 0) e.images["agentview_image"] = images_.render(env_, spec, e, plan_.image_every);
         return e;
       }
-      const std::string why = expert_.failure()[0] ? "expert: " + std::string(expert_.failure()) : std::string(ms::task::to_string(env_.info().failure));
+      const std::string why = expert_.failure() ? "expert: " + std::string(*expert_.failure()) : std::string(ms::task::to_string(env_.info().failure));
       ++redraw_reasons[std::string(ms::scene::to_string(q.task)) + " " + why.substr(0, 60)];
     }
     ms::detail::fail("episode ", k, ": no successful expert episode in ", plan_.max_draws, " draws (", ms::scene::to_string(q.task), " ",

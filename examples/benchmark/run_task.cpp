@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
     }
     const auto quoted = [](std::string_view text) { return nlohmann::json(text).dump(); };  // a JSON string, escaped
     std::string failure = info.success ? "null" : quoted(task::to_string(info.failure));
-    std::string why = expert.failure()[0] ? quoted(expert.failure()) : "null";
+    std::string why = expert.failure() ? quoted(*expert.failure()) : "null";
     // What the episode was about, for per-category tables: its target object (task::target_object)
     // and ARR's first relation; which conditions of the predicate did not hold at the end.
     const int target = task::target_object(spec);

@@ -312,7 +312,7 @@ TEST_CASE("the expert does not plan the arm through an obstacle in its way", "[t
     TaskEnv& e = env();
     Expert expert(e, config);
     run_expert(e, expert, s);
-    const std::string why = expert.failure() ? expert.failure() : "";
+    const std::string why(expert.failure().value_or(""));
     CAPTURE(why, manisoft::task::to_string(e.info().failure));
     CHECK_FALSE(e.info().success);
     if (check) {
@@ -333,7 +333,7 @@ TEST_CASE("the expert solves fixed clean scenes within the horizon", "[tasks][ex
     TaskEnv& e = env();
     Expert expert(e);
     run_expert(e, expert, sample(t, index));
-    CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure));
+    CAPTURE(expert.failure().value_or(""), manisoft::task::to_string(e.info().failure));
     if (e.info().success) {
       ++solved;
       CHECK(e.info().step <= e.config().horizon);
@@ -362,7 +362,7 @@ TEST_CASE("OVR: the expert carries the object over the tall obstacle between it 
       const auto& o = e.snapshot().objects[static_cast<std::size_t>(s.goal.object)];
       if (o.held) highest = std::max(highest, o.pose.translation.z());
     });
-    CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure));
+    CAPTURE(expert.failure().value_or(""), manisoft::task::to_string(e.info().failure));
     CHECK(e.info().success);
     CHECK(e.info().step <= e.config().horizon);
     CHECK(highest > wall_top);
@@ -392,7 +392,7 @@ TEST_CASE("the open fingers come down onto a tall object from above and do not k
     }
     if (phase == manisoft::task::ExpertPhase::carry) held = true;
   });
-  CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure));
+  CAPTURE(expert.failure().value_or(""), manisoft::task::to_string(e.info().failure));
   CHECK(tilt < 0.02);
   CHECK(shift < 0.003);
   CHECK(held);
@@ -422,7 +422,7 @@ TEST_CASE("the expert descends to a tight grasp slowly and stacks two plates", "
     }
     last = now;
   });
-  CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure), descend_steps);
+  CAPTURE(expert.failure().value_or(""), manisoft::task::to_string(e.info().failure), descend_steps);
   CHECK(e.info().success);
   REQUIRE(descend_steps > 0);
   // a plate is grasped from above; the descent's planned peak is tight_peak_speed (0.6 m/s;
@@ -442,7 +442,7 @@ TEST_CASE("a stack of three fits the horizon: two moves with the task world's ex
   CHECK(e.config().executor.damping_gain == 2 * manisoft::control::ModelExecutorSettings<double>{}.damping_gain);
   Expert expert(e);
   run_expert(e, expert, s);
-  CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure), e.info().step);
+  CAPTURE(expert.failure().value_or(""), manisoft::task::to_string(e.info().failure), e.info().step);
   CHECK(expert.moves() == 2);
   CHECK(e.info().success);
   CHECK(e.info().step <= e.config().horizon);
@@ -602,7 +602,7 @@ TEST_CASE("a descent that ends short of its grasp backs off and re-tries with an
   // the cup is round: the re-try's grasp is the same annotation turned about its axis (at least
   // the 0.2 rad the exclusion compares)
   CHECK(Eigen::AngleAxisd(descent_ends[0] * descent_ends[1].transpose()).angle() > 0.2);
-  CAPTURE(expert.failure(), manisoft::task::to_string(e.info().failure));
+  CAPTURE(expert.failure().value_or(""), manisoft::task::to_string(e.info().failure));
   CHECK(e.info().success);
 }
 

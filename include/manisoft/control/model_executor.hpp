@@ -744,6 +744,14 @@ class ModelExecutor {
     return Scalar(0.5) * v * a + v * (x - a);
   }
 
+  /// Peak speed of path_timing() over its mean speed (distance / duration): 1.875 quintic;
+  /// 2 / (1 + cruise) with a cruise. A planner times a line of given peak speed with it.
+  static Scalar peak_speed_ratio(Scalar cruise) { return cruise > Scalar(0) ? Scalar(2) / (Scalar(1) + cruise) : Scalar(1.875); }
+  /// Peak acceleration of path_timing() in units of distance / duration^2: 6 / (1 - cruise^2)
+  /// with a cruise (smoothstep speed ramps over (1 - cruise) / 2 of the duration at each end);
+  /// 5.7735 (10 / sqrt(3)) quintic.
+  static Scalar peak_acceleration_ratio(Scalar cruise) { return cruise > Scalar(0) ? Scalar(6) / (Scalar(1) - cruise * cruise) : Scalar(5.7735); }
+
  private:
 
   /// Plans the knots of time fraction (u0, u1] of the current path (the knot at u0 is the last

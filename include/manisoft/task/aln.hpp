@@ -12,6 +12,7 @@
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/scene/scene_spec.hpp"
 #include "manisoft/task/conditions.hpp"
+#include "manisoft/task/moves.hpp"
 #include "manisoft/task/success.hpp"
 
 namespace manisoft::task {
@@ -51,6 +52,20 @@ struct Aln {
   static bool holds_at_start(const Conditions& c) { return c.holds("position") && c.holds("orientation"); }
 
   static int target_object(const scene::SceneSpec& spec) { return spec.goal.object; }
+
+  // ---- the expert's moves (moves.hpp)
+  static constexpr bool states_yaw = true;
+  static int moves(const scene::SceneSpec&) { return 1; }
+  /// The object at the goal pose, in the symmetric equivalent nearest its current orientation.
+  static Move move(int, const MoveScene& s) {
+    const auto& g = s.spec.goal;
+    const math::Pose<double> now = s.pose(g.object);
+    math::Pose<double> p = g.goal_pose;
+    p.translation.z() += s.place_clearance;
+    p.rotation = nearest_equivalent(now.rotation, p.rotation, g.symmetry);
+    return {g.object, p};
+  }
+  static Support support(int, const scene::SceneSpec&) { return {}; }
 };
 
 /// ALN's predicate on its own.

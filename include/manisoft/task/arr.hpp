@@ -17,6 +17,7 @@
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/scene/scene_spec.hpp"
 #include "manisoft/task/conditions.hpp"
+#include "manisoft/task/moves.hpp"
 #include "manisoft/task/success.hpp"
 
 namespace manisoft::task {
@@ -94,6 +95,30 @@ struct Arr {
   static int target_object(const scene::SceneSpec& spec) {
     return spec.goal.relations.empty() || spec.goal.relations.front().objects.empty() ? -1 : spec.goal.relations.front().objects.front();
   }
+
+  // ---- the expert's moves (moves.hpp)
+  static constexpr bool states_yaw = false;
+  /// One move per placed object of each relation (Relation::spots).
+  static int moves(const scene::SceneSpec& spec) {
+    int n = 0;
+    for (const auto& r : spec.goal.relations) n += static_cast<int>(r.spots.size());
+    return n;
+  }
+  /// Move k: the relation's object at the free spot the scene gives for it, at its height.
+  static Move move(int k, const MoveScene& s) {
+    const double top = s.spec.table.top_center.z();
+    int n = 0;
+    for (const auto& r : s.spec.goal.relations)
+      for (std::size_t j = 0; j < r.spots.size(); ++j, ++n)
+        if (n == k) {
+          const int o = r.objects.at(j);
+          math::Pose<double> p = s.pose(o);
+          p.translation = Eigen::Vector3d(r.spots[j].x(), r.spots[j].y(), top + (p.translation.z() - top) + s.place_clearance);
+          return {o, p};
+        }
+    ::manisoft::detail::fail("ARR: no move ", k, " among the scene's ", n);
+  }
+  static Support support(int, const scene::SceneSpec&) { return {}; }
 };
 
 /// ARR's predicate on its own.

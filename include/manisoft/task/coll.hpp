@@ -3,7 +3,7 @@
 // receptacle annotation, in the container's asset frame), the object touching the container and
 // not the table, both released and at rest (success.hpp), held for TaskEnvConfig::hold_steps.
 // The goal's categories, sampling and language live with the scene sampler and the language
-// library; the expert's moves in expert.hpp.
+// library; the expert's moves are below (moves.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -17,6 +17,7 @@
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/scene/scene_spec.hpp"
 #include "manisoft/task/conditions.hpp"
+#include "manisoft/task/moves.hpp"
 #include "manisoft/task/success.hpp"
 
 namespace manisoft::task {
@@ -76,6 +77,22 @@ struct Coll {
 
   /// The object the episode is about (per-category tables): the one to collect.
   static int target_object(const scene::SceneSpec& spec) { return spec.goal.object; }
+
+  // ---- the expert's moves (moves.hpp)
+  static constexpr bool states_yaw = false;
+  static int moves(const scene::SceneSpec&) { return 1; }
+  /// The object over the container's placement point, its bottom place_clearance above the
+  /// rim (the expert lowers it on into the container: SupportKind::into).
+  static Move move(int, const MoveScene& s) {
+    const auto& g = s.spec.goal;
+    const math::Pose<double> container = s.pose(g.container);
+    const auto& rc = s.asset(g.container).receptacles.at(0);
+    const math::Pose<double> opening = container * rc.opening, placement = container * rc.placement;
+    math::Pose<double> p = s.pose(g.object);
+    p.translation = Eigen::Vector3d(placement.translation.x(), placement.translation.y(), opening.translation.z() + s.place_clearance);
+    return {g.object, p};
+  }
+  static Support support(int, const scene::SceneSpec& spec) { return {spec.goal.container, SupportKind::into}; }
 };
 
 /// COLL's predicate on its own (hand-built states, recorded episodes).

@@ -19,6 +19,7 @@
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/scene/scene_spec.hpp"
 #include "manisoft/task/conditions.hpp"
+#include "manisoft/task/moves.hpp"
 #include "manisoft/task/success.hpp"
 
 namespace manisoft::task {
@@ -62,6 +63,19 @@ struct Ovr {
   static bool holds_at_start(const Conditions& c) { return c.holds("position"); }
 
   static int target_object(const scene::SceneSpec& spec) { return spec.goal.object; }
+
+  // ---- the expert's moves (moves.hpp)
+  static constexpr bool states_yaw = false;
+  static int moves(const scene::SceneSpec&) { return 1; }
+  /// The object at the marker's position as it stands (the expert's carry lifts it over the
+  /// obstacle between).
+  static Move move(int, const MoveScene& s) {
+    const auto& g = s.spec.goal;
+    math::Pose<double> p = s.pose(g.object);
+    p.translation = g.goal_pose.translation + Eigen::Vector3d(0, 0, s.place_clearance);
+    return {g.object, p};
+  }
+  static Support support(int, const scene::SceneSpec&) { return {}; }
 };
 
 }  // namespace manisoft::task

@@ -7,7 +7,8 @@
 // the scene by `goal(spec, library)` (which refuses an ill-formed goal), `evaluate(snapshot,
 // goal, tolerances)` returning the named conditions (success: all hold), `holds_at_start(conditions)`
 // (the goal already met before any step, read off the conditions at reset: the scene is no task), `target_object(spec)` and
-// `tables_by_category` (whether evaluation groups its episodes by the target's category).
+// `tables_by_category` (whether evaluation groups its episodes by the target's category), and the
+// expert's moves (moves.hpp): `states_yaw`, `moves(spec)`, `move(k, scene)`, `support(k, spec)`.
 #pragma once
 
 #include <array>
@@ -22,6 +23,7 @@
 #include "manisoft/task/arr.hpp"
 #include "manisoft/task/coll.hpp"
 #include "manisoft/task/conditions.hpp"
+#include "manisoft/task/moves.hpp"
 #include "manisoft/task/ovr.hpp"
 #include "manisoft/task/stk.hpp"
 #include "manisoft/task/success.hpp"
@@ -30,7 +32,7 @@ namespace manisoft::task {
 
 template <typename T>
 concept TaskType = requires(const scene::SceneSpec& spec, const scene::AssetLibrary& library, const Snapshot& snapshot,
-                            const typename T::Goal& goal, const Tolerances& tol) {
+                            const typename T::Goal& goal, const Tolerances& tol, const MoveScene& move_scene) {
   { T::id } -> std::convertible_to<scene::Task>;
   { T::summary } -> std::convertible_to<std::string_view>;
   { T::goal(spec, library) } -> std::same_as<typename T::Goal>;
@@ -38,6 +40,10 @@ concept TaskType = requires(const scene::SceneSpec& spec, const scene::AssetLibr
   { T::holds_at_start(T::evaluate(snapshot, goal, tol)) } -> std::same_as<bool>;
   { T::target_object(spec) } -> std::same_as<int>;
   { T::tables_by_category } -> std::convertible_to<bool>;
+  { T::states_yaw } -> std::convertible_to<bool>;
+  { T::moves(spec) } -> std::same_as<int>;
+  { T::move(0, move_scene) } -> std::same_as<Move>;
+  { T::support(0, spec) } -> std::same_as<Support>;
 };
 
 /// Calls f(T{}) with the type of the task `task`; the one place a task enum becomes a type.

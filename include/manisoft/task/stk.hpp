@@ -14,6 +14,7 @@
 #include "manisoft/scene/asset_library.hpp"
 #include "manisoft/scene/scene_spec.hpp"
 #include "manisoft/task/conditions.hpp"
+#include "manisoft/task/moves.hpp"
 #include "manisoft/task/success.hpp"
 
 namespace manisoft::task {
@@ -65,6 +66,24 @@ struct Stk {
 
   /// The first item the stack moves: the top one (the bottom item stays where it is).
   static int target_object(const scene::SceneSpec& spec) { return spec.goal.items.empty() ? -1 : spec.goal.items.back(); }
+
+  // ---- the expert's moves (moves.hpp)
+  static constexpr bool states_yaw = false;
+  /// items[k + 1] onto items[k] for k = 0, 1, ...
+  static int moves(const scene::SceneSpec& spec) { return static_cast<int>(spec.goal.items.size()) - 1; }
+  /// Move k: the item onto the receptacle of the item below, or onto its top, as that stands now.
+  static Move move(int k, const MoveScene& s) {
+    const auto& items = s.spec.goal.items;
+    const int below = items.at(static_cast<std::size_t>(k)), item = items.at(static_cast<std::size_t>(k) + 1);
+    const math::Pose<double> b = s.pose(below);
+    const auto& ab = s.asset(below);
+    math::Pose<double> p = s.pose(item);
+    const Eigen::Vector3d on = ab.receptacles.empty() ? Eigen::Vector3d(b.translation + Eigen::Vector3d(0, 0, scene::asset_height(ab)))
+                                                      : Eigen::Vector3d((b * ab.receptacles.front().placement).translation);
+    p.translation = on + Eigen::Vector3d(0, 0, s.place_clearance);
+    return {item, p};
+  }
+  static Support support(int k, const scene::SceneSpec& spec) { return {spec.goal.items.at(static_cast<std::size_t>(k)), SupportKind::onto}; }
 };
 
 /// STK's predicate on its own.
