@@ -5,7 +5,10 @@ num_threads), 2 and 1 threads) for B = 1, 8, 64, in the same run. Every arm take
 per element, as bench_env's BatchedReachEnv benchmark) and no episode ends while timed (the
 horizon is the default 1500; --steps < 1500). Prints min and median over --repeats of the wall
 time of --steps batch steps, as control steps a minute (arms x steps / wall time).
-Run: PYTHONPATH=build/<config>/python /usr/bin/python3 benchmarks/python_vec_env_step.py
+With --env TASK the same for a task (make_env(TASK, render=False, privileged=True) against
+make_vec_env(TASK, B)): arms hold zero torques with the gripper open, so each step has the rod,
+the gripper, the scene's objects and their contacts; no episode ends while timed.
+Run: PYTHONPATH=build/<config>/python /usr/bin/python3 benchmarks/python_vec_env_step.py [--env ALN]
 """
 import argparse
 import statistics
@@ -22,10 +25,22 @@ def mild_action(rows):
     return a
 
 
-def time_loop(envs, steps):
-    action = mild_action(20)
+def env_action(env):
+    return mild_action(20) if env == "reach" else np.zeros(61)
+
+
+def make_single(env, i):
+    if env == "reach":
+        return manisoft.make_env("reach", seed=i)
+    single = manisoft.make_env(env, "clean", seed=0, render=False, privileged=True)
+    single.reset(options={"index": i})
+    return single
+
+
+def time_loop(envs, steps, action):
     for env in envs:
-        env.reset()
+        if isinstance(env, manisoft.ReachEnv):
+            env.reset()
     t0 = time.perf_counter()
     for _ in range(steps):
         for env in envs:
@@ -33,8 +48,8 @@ def time_loop(envs, steps):
     return time.perf_counter() - t0
 
 
-def time_vec(vec, steps):
-    actions = np.broadcast_to(mild_action(20), (vec.num_envs, 20, 3)).copy()
+def time_vec(vec, steps, action):
+    actions = np.broadcast_to(action, (vec.num_envs,) + action.shape).copy()
     vec.reset()
     t0 = time.perf_counter()
     for _ in range(steps):
@@ -55,13 +70,15 @@ def main():
     p.add_argument("--steps", type=int, default=100, help="batch steps a repeat (< 1500: no episode ends)")
     p.add_argument("--threads", type=int, nargs="+", default=[2, 1], help="make_vec_env's num_threads, each measured")
     p.add_argument("--arms", type=int, nargs="+", default=[1, 8, 64])
+    p.add_argument("--env", default="reach", help="reach, or a task (COLL, ALN, STK, ARR, OVR)")
     args = p.parse_args()
+    action = env_action(args.env)
     for arms in args.arms:
-        envs = [manisoft.make_env("reach", seed=i) for i in range(arms)]
-        report("Python loop, make_env", arms, 1, args.steps, [time_loop(envs, args.steps) for _ in range(args.repeats)])
+        envs = [make_single(args.env, i) for i in range(arms)]
+        report("Python loop, make_env", arms, 1, args.steps, [time_loop(envs, args.steps, action) for _ in range(args.repeats)])
         for threads in args.threads:
-            vec = manisoft.make_vec_env("reach", arms, num_threads=threads, seed=0)
-            report("make_vec_env", arms, threads, args.steps, [time_vec(vec, args.steps) for _ in range(args.repeats)])
+            vec = manisoft.make_vec_env(args.env, arms, num_threads=threads, seed=0)
+            report("make_vec_env", arms, threads, args.steps, [time_vec(vec, args.steps, action) for _ in range(args.repeats)])
             vec.close()
         for env in envs:
             env.close()

@@ -2,7 +2,7 @@
 
 The build compiles this file into the module, which runs it in its own namespace when it loads
 (python_side.cpp), so everything here is `manisoft.<name>`; it uses the compiled classes
-(ReachEnv, TaskEnv, _ReachBatch) as globals of that namespace.
+(ReachEnv, TaskEnv, _ReachBatch, _TaskBatch) as globals of that namespace.
 
 Spaces follow Gymnasium's (gymnasium is not needed):
   Box(low, high, shape, dtype)  arrays within [low, high]; low = -inf / high = inf where unbounded
@@ -11,8 +11,8 @@ Spaces follow Gymnasium's (gymnasium is not needed):
   Sequence(space)               a stack of any number of entries of `space` (the objects' poses)
 each with .sample() (its own numpy Generator; .seed(s) makes the draws repeatable) and .contains(x).
 
-make_vec_env("reach", num_envs, ...) is B reach arms stepped by one call over a pool of threads,
-with Gymnasium 1.x's VectorEnv API and its NEXT_STEP autoreset (metadata["autoreset_mode"]).
+make_vec_env("reach" or a task, num_envs, ...) is B arms stepped by one call over a pool of
+threads, with Gymnasium 1.x's VectorEnv API and its NEXT_STEP autoreset (metadata["autoreset_mode"]).
 """
 
 import enum
@@ -257,7 +257,121 @@ class AutoresetMode(str, enum.Enum):
     DISABLED = "Disabled"
 
 
-class ReachVectorEnv:
+class _VectorEnv:
+    """Gymnasium 1.x's VectorEnv API over a compiled batch (the reach and the task batches): reset
+    with seeds and reset masks, step, NEXT_STEP autoreset, read-only views, Gymnasium's "_key"
+    info masks. A subclass makes the batch and the spaces, and names its arrays."""
+
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+    render_mode = None
+    _OBSERVATIONS = ()
+    _INFOS = ()
+    _EPISODE = "seeds"  # the batch's array of each arm's episode seed
+
+    def __init__(self, batch, seed):
+        self._batch = batch
+        self.num_envs = batch.num_envs
+        self.num_threads = batch.threads
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self._first_seed = _count(seed, "make_vec_env: seed")
+        self._arrays = batch.arrays()
+        self._every_arm = np.ones(self.num_envs, dtype=bool)  # the infos' "_key" masks: every arm has every key
+        self._every_arm.flags.writeable = False
+        self._started = False
+        self.closed = False
+
+    def reset(self, *, seed=None, options=None):
+        self._check_open()
+        options = dict(options or {})
+        mask = options.pop("reset_mask", None)
+        if options:
+            raise ValueError(f"reset: unknown options {sorted(options)} (a vector environment takes reset_mask)")
+        seeds = self._seeds(seed)
+        if mask is not None:
+            mask = np.asarray(mask)
+            if mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
+                raise ValueError(f"reset: reset_mask must be a bool array of shape ({self.num_envs},), "
+                                 f"got {mask.dtype} {mask.shape}")
+            if not self._started:
+                raise ValueError("reset: the first reset starts every arm (no reset_mask)")
+        self._batch.reset(seeds, mask)
+        self._started = True
+        return self._observations(), self._infos()
+
+    def step(self, actions):
+        self._check_open()
+        if not self._started:
+            raise RuntimeError("call reset() before step()")
+        a = np.asarray(actions)
+        if a.dtype.kind not in "fiu":
+            raise ValueError(f"step: actions dtype must be real (float64 preferred), got {a.dtype}")
+        if a.shape != self.action_space.shape:
+            raise ValueError(f"step: actions must have shape {self.action_space.shape} {self._ACTION_LAYOUT}, got {a.shape}")
+        self._batch.step(np.ascontiguousarray(a, dtype=np.float64))
+        arrays = self._arrays
+        return (self._observations(), arrays["rewards"], arrays["terminated"], arrays["truncated"], self._infos())
+
+    def close(self, **kwargs):
+        """Stops the batch's threads and frees its arms; later calls raise RuntimeError."""
+        if not self.closed:
+            self._arrays = None
+            self._batch = None
+            self.closed = True
+
+    @property
+    def unwrapped(self):
+        return self
+
+    @property
+    def np_random(self):
+        return self.single_action_space.np_random
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def _check_open(self):
+        if self.closed:
+            raise RuntimeError("the vector environment is closed")
+
+    def _seeds(self, seed):
+        n = self.num_envs
+        if seed is None:
+            if not self._started:
+                return self._first_seed + np.arange(n, dtype=np.uint64)
+            return self._arrays[self._EPISODE] + np.uint64(n)
+        if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+            return _count(seed, "reset: seed") + np.arange(n, dtype=np.uint64)
+        seeds = [_count(s, f"reset: seed[{i}]") for i, s in enumerate(seed)]
+        if len(seeds) != n:
+            raise ValueError(f"reset: seed holds {len(seeds)} values, expected num_envs = {n}")
+        return np.array(seeds, dtype=np.uint64)
+
+    def _observations(self):
+        return {key: self._arrays[key] for key in self._OBSERVATIONS}
+
+    def _infos(self):
+        infos = {key: self._arrays[key] for key in self._INFOS}
+        infos["seed"] = self._arrays[self._EPISODE]
+        for key in list(infos):
+            infos["_" + key] = self._every_arm
+        return infos
+
+
+def _checked_counts(num_envs, num_threads):
+    num_threads = (os.cpu_count() or 1) if num_threads is None else num_threads
+    if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+        raise ValueError(f"make_vec_env: num_envs = {num_envs!r} must be an int >= 1")
+    if isinstance(num_threads, bool) or not isinstance(num_threads, (int, np.integer)) or num_threads < 1:
+        raise ValueError(f"make_vec_env: num_threads = {num_threads!r} must be an int >= 1")
+    return int(num_envs), int(num_threads)
+
+
+class ReachVectorEnv(_VectorEnv):
     """num_envs reach environments stepped together (Gymnasium 1.x VectorEnv API, without gymnasium).
 
     Arm i of the batch follows exactly the trajectory of make_env("reach", target_set, horizon=...)
@@ -286,115 +400,82 @@ class ReachVectorEnv:
     The GIL is released while the batch resets and steps (over num_threads threads).
     """
 
-    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
-    render_mode = None
     _OBSERVATIONS = ("end_effector", "target", "node_positions", "node_velocities")
     _INFOS = ("success", "steps", "position_error", "rotation_error", "clipped", "max_node_speed")
+    _ACTION_LAYOUT = "(num_envs, rows, 3)"
 
     def __init__(self, num_envs, num_threads=None, target_set="table", seed=0, horizon=None):
-        num_threads = (os.cpu_count() or 1) if num_threads is None else num_threads
+        num_envs, num_threads = _checked_counts(num_envs, num_threads)
         horizon = HORIZON if horizon is None else horizon  # noqa: F821 (compiled constant)
-        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
-            raise ValueError(f"make_vec_env: num_envs = {num_envs!r} must be an int >= 1")
-        if isinstance(num_threads, bool) or not isinstance(num_threads, (int, np.integer)) or num_threads < 1:
-            raise ValueError(f"make_vec_env: num_threads = {num_threads!r} must be an int >= 1")
-        self._batch = _ReachBatch(int(num_envs), int(num_threads), target_set, int(horizon))  # noqa: F821
-        self.num_envs = int(num_envs)
-        self.num_threads = self._batch.threads
+        batch = _ReachBatch(num_envs, num_threads, target_set, int(horizon))  # noqa: F821
         self.horizon = int(horizon)
-        self.single_action_space, self.single_observation_space = _spaces_of(self._batch)
+        self.single_action_space, self.single_observation_space = _spaces_of(batch)
         del self.single_observation_space.spaces["time"]  # the batch observes no time (infos["steps"] * CONTROL_DT)
-        self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
-        self._first_seed = _count(seed, "make_vec_env: seed")
-        self._arrays = self._batch.arrays()
-        self._every_arm = np.ones(self.num_envs, dtype=bool)  # the infos' "_key" masks: every arm has every key
-        self._every_arm.flags.writeable = False
-        self._started = False
-        self.closed = False
-
-    def reset(self, *, seed=None, options=None):
-        self._check_open()
-        options = dict(options or {})
-        mask = options.pop("reset_mask", None)
-        if options:
-            raise ValueError(f"reset: unknown options {sorted(options)} (the vector reach environment takes reset_mask)")
-        seeds = self._seeds(seed)
-        if mask is not None:
-            mask = np.asarray(mask)
-            if mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
-                raise ValueError(f"reset: reset_mask must be a bool array of shape ({self.num_envs},), "
-                                 f"got {mask.dtype} {mask.shape}")
-            if not self._started:
-                raise ValueError("reset: the first reset starts every arm (no reset_mask)")
-        self._batch.reset(seeds, mask)
-        self._started = True
-        return self._observations(), self._infos()
-
-    def step(self, actions):
-        self._check_open()
-        if not self._started:
-            raise RuntimeError("call reset() before step()")
-        a = np.asarray(actions)
-        if a.dtype.kind not in "fiu":
-            raise ValueError(f"step: actions dtype must be real (float64 preferred), got {a.dtype}")
-        if a.shape != self.action_space.shape:
-            raise ValueError(f"step: actions must have shape {self.action_space.shape} (num_envs, rows, 3), got {a.shape}")
-        self._batch.step(np.ascontiguousarray(a, dtype=np.float64))
-        arrays = self._arrays
-        return (self._observations(), arrays["rewards"], arrays["terminated"], arrays["truncated"], self._infos())
-
-    def close(self, **kwargs):
-        """Stops the batch's threads and frees its arms; later calls raise RuntimeError."""
-        if not self.closed:
-            self._arrays = None
-            self._batch = None
-            self.closed = True
-
-    @property
-    def unwrapped(self):
-        return self
-
-    @property
-    def np_random(self):
-        return self.single_action_space.np_random
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
+        super().__init__(batch, seed)
 
     def __repr__(self):
         return f"ReachVectorEnv(num_envs={self.num_envs}, num_threads={self.num_threads}, horizon={self.horizon})"
 
-    def _check_open(self):
-        if self.closed:
-            raise RuntimeError("the vector environment is closed")
 
-    def _seeds(self, seed):
-        n = self.num_envs
-        if seed is None:
-            if not self._started:
-                return self._first_seed + np.arange(n, dtype=np.uint64)
-            return self._arrays["seeds"] + np.uint64(n)
-        if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
-            return _count(seed, "reset: seed") + np.arange(n, dtype=np.uint64)
-        seeds = [_count(s, f"reset: seed[{i}]") for i, s in enumerate(seed)]
-        if len(seeds) != n:
-            raise ValueError(f"reset: seed holds {len(seeds)} values, expected num_envs = {n}")
-        return np.array(seeds, dtype=np.uint64)
+class TaskVectorEnv(_VectorEnv):
+    """num_envs environments of one task and setting stepped together (Gymnasium 1.x VectorEnv API),
+    with the privileged state observation (no image).
+
+    Arm i of the batch follows exactly the episode of make_env(task, setting, seed=seed,
+    render=False, privileged=True) reset to the same scene and given the same actions, whatever
+    num_threads and i.
+
+    Episodes are scenes: arm i's scene is (task, setting, split, index, seed) with make_vec_env's
+    dataset seed and an index of its own. reset(seed=s) gives arm i index s + i (a list: one index
+    an arm); reset() continues each arm's indices (its current one + num_envs; the first reset:
+    make_vec_env's first_index + i). options={"reset_mask": ...} as the reach batch's.
+    step(actions): num_envs x (3n + 1) flat actions (torques, then S; the single environment's
+    layout). Autoreset NEXT_STEP: an ended arm (terminated: success or a terminal failure;
+    truncated: the horizon T) starts its next scene (index + num_envs) at the next step, whose
+    action for it is ignored.
+    Observations: rod_nodes (B x (n + 1) x 3), end_effector, gripper_pose (B x 4 x 4),
+    gripper_width (B), gripper_state (B), object_poses (B x K x 4 x 4: the first object_count[i]
+    are arm i's objects, the others zero), object_count (B), instruction (a tuple of B str).
+    Infos: success, steps, failure (the task layer's reason: None or a name, a tuple of B), seed
+    (each arm's scene index), with Gymnasium's "_key" masks. Arrays are read-only views of the
+    batch's buffers, overwritten by the next reset or step (copy what you keep).
+    """
+
+    _OBSERVATIONS = ("rod_nodes", "end_effector", "gripper_pose", "gripper_width", "gripper_state", "object_poses", "object_count")
+    _INFOS = ("success", "steps")
+    _EPISODE = "indices"
+    _ACTION_LAYOUT = "(num_envs, 3n + 1)"
+
+    def __init__(self, task, num_envs, num_threads=None, setting="clean", split="train", seed=0, first_index=0):
+        num_envs, num_threads = _checked_counts(num_envs, num_threads)
+        self.task, self.setting, self.split = task, setting, split
+        batch = _TaskBatch(task, setting, split, _count(seed, "make_vec_env: seed"), num_envs, num_threads)  # noqa: F821
+        self.horizon = HORIZON  # noqa: F821 (compiled constant)
+        self.single_action_space, _ = _spaces_of(batch)
+        n, k = batch.n_elements, batch.max_objects
+        unbounded = lambda *shape: Box(-np.inf, np.inf, shape, np.float64)  # noqa: E731
+        self.single_observation_space = Dict({
+            "rod_nodes": unbounded(n + 1, 3), "end_effector": unbounded(4, 4), "gripper_pose": unbounded(4, 4),
+            "gripper_width": unbounded(), "gripper_state": Box(0, 1, (), np.int64), "object_poses": unbounded(k, 4, 4),
+            "object_count": Box(0, k, (), np.int64)})
+        self._instructions = None
+        super().__init__(batch, first_index)
 
     def _observations(self):
-        return {key: self._arrays[key] for key in self._OBSERVATIONS}
+        obs = super()._observations()
+        if self._instructions is None or not self._arrays["steps"].all():  # an arm started a scene
+            self._instructions = tuple(self._batch.instructions())
+        obs["instruction"] = self._instructions
+        return obs
 
     def _infos(self):
-        infos = {key: self._arrays[key] for key in self._INFOS}
-        infos["seed"] = self._arrays["seeds"]
-        for key in list(infos):
-            infos["_" + key] = self._every_arm
+        infos = super()._infos()
+        infos["failure"] = self._batch.failures()
+        infos["_failure"] = self._every_arm
         return infos
+
+    def __repr__(self):
+        return f"TaskVectorEnv({self.task!r}, num_envs={self.num_envs}, num_threads={self.num_threads}, setting={self.setting!r})"
 
 
 def _count(value, what):
@@ -403,13 +484,19 @@ def _count(value, what):
     return np.uint64(value)
 
 
-def make_vec_env(name, num_envs, num_threads=None, target_set="table", seed=0, horizon=None):
+def make_vec_env(name, num_envs, num_threads=None, **kwargs):
     """num_envs environments stepped together by one call over num_threads threads (default: the
-    machine's cores): make_vec_env("reach", num_envs, num_threads=None, target_set="table"|"equilibria",
-    seed=0, horizon=HORIZON) -> ReachVectorEnv (Gymnasium 1.x VectorEnv API, NEXT_STEP autoreset)."""
-    if name != "reach":
-        raise ValueError(f"make_vec_env: unknown environment {name!r} (available: reach)")
-    return ReachVectorEnv(num_envs, num_threads, target_set, seed, horizon)
+    machine's cores), Gymnasium 1.x VectorEnv API, NEXT_STEP autoreset:
+      make_vec_env("reach", num_envs, num_threads=None, target_set="table"|"equilibria", seed=0,
+                    horizon=HORIZON) -> ReachVectorEnv
+      make_vec_env(task, num_envs, num_threads=None, setting="clean", split="train", seed=0,
+                    first_index=0) -> TaskVectorEnv (a task of manisoft.tasks(): the state track)"""
+    if name == "reach":
+        return ReachVectorEnv(num_envs, num_threads, **kwargs)
+    names = [t["name"] for t in tasks()]  # noqa: F821 (compiled function)
+    if name not in names:
+        raise ValueError(f"make_vec_env: unknown environment {name!r} (available: {', '.join(names)}, reach)")
+    return TaskVectorEnv(name, num_envs, num_threads, **kwargs)
 
 
 del _cls

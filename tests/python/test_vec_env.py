@@ -1,7 +1,8 @@
-"""The vector reach environment (manisoft.make_vec_env) against single reach environments
-(manisoft.make_env("reach")): each arm bit-identical to a single environment with the same seeds
-and actions at 1 and 2 threads, reset masks, Gymnasium's NEXT_STEP autoreset, bad actions refused
-with nothing changed; and the spaces' sample / contains.
+"""The vector environments (manisoft.make_vec_env) against single environments: each reach arm
+bit-identical to make_env("reach") with the same seeds and actions at 1 and 2 threads, reset
+masks, Gymnasium's NEXT_STEP autoreset, bad actions refused with nothing changed; each task arm
+bit-identical to make_env(task, render=False, privileged=True) on the same scene, autoreset at the
+horizon; and the spaces' sample / contains.
 Run: PYTHONPATH=<build>/python python3 -m unittest test_vec_env."""
 import unittest
 
@@ -173,8 +174,8 @@ class VecEnvApi(unittest.TestCase):
         self.vec.close()
         with self.assertRaisesRegex(RuntimeError, "closed"):
             self.vec.reset()
-        with self.assertRaisesRegex(ValueError, "unknown environment"):
-            manisoft.make_vec_env("COLL", 2)
+        with self.assertRaisesRegex(ValueError, "unknown environment 'PICK'"):
+            manisoft.make_vec_env("PICK", 2)
 
 
 class Spaces(unittest.TestCase):
@@ -229,6 +230,95 @@ class Spaces(unittest.TestCase):
         del sample["time"]
         self.assertFalse(obs_space.contains(sample))  # a key missing
 
+
+TASK_OBSERVATIONS = ("rod_nodes", "end_effector", "gripper_pose", "gripper_width", "gripper_state")
+
+
+class TaskVecAgainstSingle(unittest.TestCase):
+    """make_vec_env(task): arm i against make_env(task, render=False, privileged=True) reset to the
+    same scene and driven by the same actions (the single environment's expert, with noise)."""
+
+    def assert_arm_equals(self, vec_result, i, single_result):
+        obs, reward, terminated, truncated, info = vec_result
+        s_obs, s_reward, s_terminated, s_truncated, s_info = single_result
+        for key in TASK_OBSERVATIONS:
+            self.assertTrue(np.array_equal(obs[key][i], s_obs[key]), f"arm {i} {key}")
+        count = obs["object_count"][i]
+        self.assertEqual(count, len(s_obs["object_poses"]))
+        self.assertTrue(np.array_equal(obs["object_poses"][i][:count], np.asarray(s_obs["object_poses"])), f"arm {i} object_poses")
+        self.assertFalse(obs["object_poses"][i][count:].any())
+        self.assertEqual(obs["instruction"][i], s_obs["instruction"])
+        self.assertEqual((reward[i], terminated[i], truncated[i]), (s_reward, s_terminated, s_truncated), f"arm {i}")
+        self.assertEqual((info["success"][i], info["steps"][i], info["failure"][i]), (s_info["success"], s_info["steps"], s_info["failure"]))
+
+    def run_against_singles(self, threads, steps=120):
+        vec = manisoft.make_vec_env("ALN", B, num_threads=threads, setting="clean", seed=0)
+        self.assertEqual((vec.num_threads, vec.single_action_space.shape, vec.action_space.shape), (threads, (61,), (B, 61)))
+        obs, info = vec.reset(seed=4)  # arm i: scene index 4 + i
+        np.testing.assert_array_equal(info["seed"], 4 + np.arange(B))
+        singles = [manisoft.make_env("ALN", "clean", seed=0, render=False, privileged=True) for _ in range(B)]
+        for i, env in enumerate(singles):
+            s_obs, s_info = env.reset(options={"index": 4 + i})
+            self.assert_arm_equals((obs, np.zeros(B), np.zeros(B, bool), np.zeros(B, bool), info), i, (s_obs, 0.0, False, False, s_info))
+        for key in TASK_OBSERVATIONS + ("object_poses", "object_count"):
+            self.assertTrue(vec.single_observation_space[key].contains(obs[key][0]), key)
+        rng = np.random.default_rng(1)
+        for _ in range(steps):
+            a = np.stack([env.expert_action() for env in singles])
+            a[:, 3:-1] += rng.normal(scale=1.0, size=(B, 57))  # element 0 takes no torque, S stays
+            result = vec.step(a)
+            for i, env in enumerate(singles):
+                self.assert_arm_equals(result, i, env.step(a[i]))
+        vec.close()
+
+    def test_one_thread(self):
+        self.run_against_singles(1)
+
+    def test_two_threads(self):
+        self.run_against_singles(2)
+
+    def test_autoreset_after_a_terminal_failure_and_at_the_horizon(self):
+        """Zero torques: in COLL scene 10 the falling arm knocks the object off the table
+        (terminated, object_off_table), scene 11 runs to the horizon (truncated, timeout). Each arm
+        against a single environment reset to the next index (+ B) at the step after its episode
+        ended, as NEXT_STEP prescribes, over the whole horizon."""
+        vec = manisoft.make_vec_env("COLL", 2, num_threads=2, seed=0, first_index=10)
+        obs, info = vec.reset()
+        np.testing.assert_array_equal(info["seed"], [10, 11])
+        zero = np.zeros((2, 61))
+        bad = zero.copy()
+        bad[1, 7] = np.nan
+        with self.assertRaisesRegex(ValueError, r"arm 1: action entry 7 \(element 2, component d2\) = nan is not finite"):
+            vec.step(bad)
+        singles = [manisoft.make_env("COLL", "clean", seed=0, render=False, privileged=True) for _ in range(2)]
+        index = [10, 11]
+        for i, env in enumerate(singles):
+            env.reset(options={"index": index[i]})
+        ended = [None, None]  # the single episode's last result, until the arm resets
+        events = []
+        for step in range(manisoft.HORIZON + 1):
+            actions = zero.copy()
+            actions[[i for i in range(2) if ended[i]]] = np.nan  # an ending arm's action is ignored, not even checked
+            result = vec.step(actions)
+            for i, env in enumerate(singles):
+                if ended[i]:
+                    index[i] += 2
+                    s_obs, s_info = env.reset(options={"index": index[i]})
+                    expected = (s_obs, 0.0, False, False, s_info)
+                    events.append((step, i, index[i], ended[i][4]["failure"]))
+                    ended[i] = None
+                else:
+                    expected = env.step(zero[i])
+                    if expected[2] or expected[3]:
+                        ended[i] = expected
+                self.assert_arm_equals(result, i, expected)
+                self.assertEqual(result[4]["seed"][i], index[i])
+        # arm 0 restarted after its terminal failure, arm 1 after the horizon
+        self.assertEqual(events[0][1:], (0, 12, "object_off_table"))
+        self.assertIn((manisoft.HORIZON, 1, 13, "timeout"), events)
+        with self.assertRaisesRegex(ValueError, "unknown environment 'PICK'"):
+            manisoft.make_vec_env("PICK", 2)
+        vec.close()
 
 if __name__ == "__main__":
     unittest.main()
