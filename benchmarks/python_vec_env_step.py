@@ -6,8 +6,10 @@ per element, as bench_env's BatchedReachEnv benchmark) and no episode ends while
 horizon is the default 1500; --steps < 1500). Prints min and median over --repeats of the wall
 time of --steps batch steps, as control steps a minute (arms x steps / wall time).
 With --env TASK the same for a task (make_env(TASK, render=False, privileged=True) against
-make_vec_env(TASK, B)): arms hold zero torques with the gripper open, so each step has the rod,
-the gripper, the scene's objects and their contacts; no episode ends while timed.
+make_vec_env(TASK, B)): arms get zero torques with the gripper open, so the arm falls onto the
+table and the objects: each step has the rod, the gripper, the objects and their contacts; an
+episode that ends (an object knocked off the table) resets within the timing, as a vector
+environment's autoreset does.
 Run: PYTHONPATH=build/<config>/python /usr/bin/python3 benchmarks/python_vec_env_step.py [--env ALN]
 """
 import argparse
@@ -44,7 +46,8 @@ def time_loop(envs, steps, action):
     t0 = time.perf_counter()
     for _ in range(steps):
         for env in envs:
-            env.step(action)
+            if any(env.step(action)[2:4]):  # a task episode that ended (the falling arm knocked an object off)
+                env.reset()
     return time.perf_counter() - t0
 
 

@@ -202,7 +202,7 @@ int run_with(const Options& o, Damping<double> damping, typename ActionPolicy<do
     manisoft::control::ProjectedExecutor executor(std::move(model), env.action_space());
     return run(o, executor, env);
   }
-  manisoft::control::MlpExecutor<double> executor(manisoft::control::Mlp<double>::load(o.weights), env.action_space().rows());
+  auto executor = manisoft::control::MlpExecutor<double>::load(o.weights, env.action_space().rows());
   return run(o, executor, env);
 }
 

@@ -8,7 +8,8 @@ BIN_DIR holds the example programs. rod_sim, reach_eval, scene_sample and render
 required (the tests build them); run_task, generate_dataset and pick_place_eval are checked when
 they are there (builds that only check them for warnings do not make them). Every case is listed
 as it runs: program, input, exit status and the message's first line, and is a row of
-docs/bad-inputs.md (tests/bad_input_table.py): the sections of flags, scene files and traces.
+docs/bad-inputs.md (tests/bad_input_table.py): the sections of flags, scene files, traces and
+weight files.
 """
 import json
 import os
@@ -130,6 +131,32 @@ def reach_eval_cases():
     refused(reach_eval, ["--seed", "1", "--targets", "1", "--out", "/dev/full"], ["writing '/dev/full' failed"], code=1)
     if reach_eval and "--load-kg" not in accepted(reach_eval, ["--help"]):
         failures.append("reach_eval --help does not list --load-kg")
+
+
+WEIGHTS = Section("Weight files", """
+An MLP executor's weight file (`control/mlp_executor.hpp`: a plain-text header, then each layer's
+weight rows and bias) is read whole before any episode: a missing file, a layer that does not fit
+what follows, a number that is not finite and a network whose sizes do not match the arm are
+refused naming the file and the line. `reach_eval --executor mlp --weights FILE --targets 1
+--seed 1 --out DIR/reach.csv`; no CSV is left. Test `bad_inputs` (`tests/programs/test_bad_inputs.py`).
+""", ["program", "weight file", "exit", "message"])
+
+
+def weight_cases():
+    reach_eval = program("reach_eval")
+    out = scratch("reach.csv")
+    head = "manisoft-mlp 1\nlayers 1\ninput 2\n"
+    for name, text, words in [("missing.txt", None, "cannot open the MLP weight file"),
+                              ("huge_layer.txt", "manisoft-mlp 1\nlayers 1\ninput 1000000\nlayer 1000000 linear\n", "huge_layer.txt:5: unexpected end of file"),
+                              ("nan_weight.txt", head + "layer 1 linear\n1 nan\n0\n", "nan_weight.txt:5: 'nan' is not finite"),
+                              ("no_bias.txt", head + "layer 1 linear\n1 2\n", "no_bias.txt:6: unexpected end of file, expected a bias row"),
+                              ("too_small.txt", head + "layer 1 linear\n1 2\n0\n", "too_small.txt: the network outputs 1 values, the action needs 3 x 20 = 60")]:
+        path = scratch(name)
+        if text is not None:
+            with open(path, "w") as f:
+                f.write(text)
+        refused(reach_eval, ["--executor", "mlp", "--weights", path, "--targets", "1", "--seed", "1", "--out", out], [words], [out], 1,
+                section=WEIGHTS, shown=name + ("" if text is None else ": " + text.replace("\n", " / ").strip(" /")))
 
 
 def edited(source, target, pattern, replacement):
@@ -272,11 +299,12 @@ def main():
     os.makedirs(SCRATCH)
     rod_sim_cases()
     reach_eval_cases()
+    weight_cases()
     flag_cases()
     scenes = scene_file_cases()
     if scenes:
         trace_cases(*scenes)
-    for section in (FLAGS, SCENES, TRACES):
+    for section in (FLAGS, SCENES, TRACES, WEIGHTS):
         section.finish(failures)
     for f in failures:
         print("FAILED:", f)

@@ -30,6 +30,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "manisoft/control/executor.hpp"
@@ -193,13 +194,17 @@ class MlpExecutor {
   using Scalar = ScalarType;
   using Array3 = Eigen::Matrix<Scalar, Eigen::Dynamic, 3>;
 
-  /// A policy whose network outputs `action_rows` x 3 values (element-major).
-  MlpExecutor(Mlp<Scalar> network, int action_rows) : network_(std::move(network)), rows_(action_rows) {
-    if (action_rows < 1) manisoft::detail::fail("MlpExecutor: action_rows = ", action_rows, " must be >= 1");
+  /// A policy whose network outputs `action_rows` x 3 values (element-major). `source` names the
+  /// network in messages (its file).
+  MlpExecutor(Mlp<Scalar> network, int action_rows, std::string_view source = "MlpExecutor") : network_(std::move(network)), rows_(action_rows) {
+    if (action_rows < 1) manisoft::detail::fail(source, ": action_rows = ", action_rows, " must be >= 1");
     if (network_.output_size() != 3 * action_rows)
-      manisoft::detail::fail("MlpExecutor: the network outputs ", network_.output_size(), " values, the action needs 3 x ", action_rows, " = ", 3 * action_rows);
+      manisoft::detail::fail(source, ": the network outputs ", network_.output_size(), " values, the action needs 3 x ", action_rows, " = ", 3 * action_rows);
     features_.setZero(network_.input_size());
   }
+
+  /// The policy of weight file `path` (Mlp::load), refused naming the file when it does not fit.
+  static MlpExecutor load(const std::string& path, int action_rows) { return MlpExecutor(Mlp<Scalar>::load(path), action_rows, path); }
 
   void reset() {}
 
