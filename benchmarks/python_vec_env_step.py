@@ -32,17 +32,17 @@ def env_action(env):
 
 
 def make_single(env, i):
+    """A single environment of `env`, reset (a task: to scene index i, as make_vec_env's arm i)."""
     if env == "reach":
-        return manisoft.make_env("reach", seed=i)
+        single = manisoft.make_env("reach", seed=i)
+        single.reset()
+        return single
     single = manisoft.make_env(env, "clean", seed=0, render=False, privileged=True)
     single.reset(options={"index": i})
     return single
 
 
 def time_loop(envs, steps, action):
-    for env in envs:
-        if isinstance(env, manisoft.ReachEnv):
-            env.reset()
     t0 = time.perf_counter()
     for _ in range(steps):
         for env in envs:
@@ -52,8 +52,8 @@ def time_loop(envs, steps, action):
 
 
 def time_vec(vec, steps, action):
+    """Steps on from where the last repetition left the arms (as time_loop does)."""
     actions = np.broadcast_to(action, (vec.num_envs,) + action.shape).copy()
-    vec.reset()
     t0 = time.perf_counter()
     for _ in range(steps):
         vec.step(actions)
@@ -81,6 +81,7 @@ def main():
         report("Python loop, make_env", arms, 1, args.steps, [time_loop(envs, args.steps, action) for _ in range(args.repeats)])
         for threads in args.threads:
             vec = manisoft.make_vec_env(args.env, arms, num_threads=threads, seed=0)
+            vec.reset()
             report("make_vec_env", arms, threads, args.steps, [time_vec(vec, args.steps, action) for _ in range(args.repeats)])
             vec.close()
         for env in envs:

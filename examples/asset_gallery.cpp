@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
   app.add_option("--levels", levels, "contact sheet: quantize each colour channel to this many levels (smaller PNG)")
       ->check(manisoft::cli::between(2, 256));
   manisoft::cli::readable_errors(app, "asset_gallery");
-  CLI11_PARSE(app, argc, argv);
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
     using namespace manisoft::assets;
     auto all = object_catalog();

@@ -89,8 +89,8 @@ inline void readable_errors(CLI::App& app, const std::string& program) {
 }
 
 /// Parses the command line: -1 to go on, else the exit code, the message printed (0 after --help,
-/// 2 after a bad flag: the code rod_sim and reach_eval have always used; CLI11_PARSE returns
-/// CLI11's own codes, 100 and above).
+/// 2 after a bad flag, the code of every program here; CLI11_PARSE would return CLI11's own codes,
+/// 100 and above).
 inline int parse(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);

@@ -2,7 +2,7 @@
 // (tabletop_scene.hpp), the parallel gripper and eight objects. It
 //   1. (--map) maps the reachable workspace over the table top for 9 candidate mounts (random
 //      bounded actuations settled to equilibrium) and prints the coverage table plus an ASCII map
-//      of the chosen mount (and writes it as a PGM image; WORLD_DEMO_MOUNT="h,pitch_deg" maps one),
+//      of the chosen mount (and writes it as a PGM image; --mount H,PITCH maps that one only),
 //   2. puts the target cube at (0.5, 0) on the table and solves the inverse statics
 //      (rod::InverseStatics, within the actuation limits) for the tool-down gripper poses above
 //      the cube, around it, at a drop-off point 15 cm to the side and down,
@@ -10,7 +10,7 @@
 //      at the cube, S = 0 at the drop-off) in ArmWorld and writes the trace, one row per control
 //      step (7 substeps of 2e-4 s, 714 Hz).
 //
-// Usage: world_demo [--out world_trace.csv] [--map] [--map-pgm workspace.pgm] [--samples N]
+// Usage: world_demo [--out world_trace.csv] [--map] [--map-pgm workspace.pgm] [--samples N] [--mount H,PITCH]
 //
 // Trace schema (CSV, comma separated, one header row, then one row per control step; SI units,
 // lab frame, z up; quaternions w, x, y, z; the row is written after the control step's substeps):
@@ -45,6 +45,7 @@
 #include "manisoft/rod/settle.hpp"
 #include "manisoft/world/arm_world.hpp"
 #include "manisoft/world/tabletop_scene.hpp"
+#include "cli_checks.hpp"
 #include "output_file.hpp"
 
 namespace {
@@ -209,24 +210,20 @@ struct Phase {
 }  // namespace
 
 int main(int argc, char** argv) {
+  CLI::App app{"world_demo: the tabletop world's scripted pick and place (trace CSV), and with --map its reachable workspace"};
   std::string out_path = "world_trace.csv", pgm_path = "workspace.pgm";
   bool do_map = false;
   int samples = 300;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) {
-      out_path = argv[++i];
-    } else if (!std::strcmp(argv[i], "--samples") && i + 1 < argc) {
-      samples = std::atoi(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--map")) {
-      do_map = true;
-    } else if (!std::strcmp(argv[i], "--map-pgm") && i + 1 < argc) {
-      pgm_path = argv[++i];
-      do_map = true;
-    } else {
-      std::fprintf(stderr, "usage: world_demo [--out trace.csv] [--map] [--map-pgm workspace.pgm] [--samples N]\n");
-      return 2;
-    }
-  }
+  std::vector<double> mount;
+  app.add_option("--out", out_path, "trace CSV to write (default world_trace.csv)");
+  app.add_flag("--map", do_map, "map the reachable workspace of 9 candidate mounts first");
+  app.add_option("--map-pgm", pgm_path, "the chosen mount's map as a PGM image (implies --map; default workspace.pgm)");
+  app.add_option("--samples", samples, "--map: random actuations per mount")->check(manisoft::cli::between(1, 1e6));
+  app.add_option("--mount", mount, "--map: map this one mount only: height above the table top (m) and pitch (deg), as H,PITCH")
+      ->delimiter(',')->expected(2)->check(manisoft::cli::between(-10, 360));
+  manisoft::cli::readable_errors(app, "world_demo");
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
+  do_map = do_map || app.count("--map-pgm") > 0 || !mount.empty();
   try {
     const world::ArmMount chosen;
     if (do_map) {
@@ -236,9 +233,9 @@ int main(int argc, char** argv) {
       std::printf("height above top [m]  pitch [deg]  settled  arm clear  grasp-capable cells (of 80)\n");
       MapResult chosen_map;
       std::vector<double> heights{0.45, 0.6, 0.75}, pitches{0.0, 30.0, 60.0};
-      if (const char* one = std::getenv("WORLD_DEMO_MOUNT")) {  // "height,pitch": map one mount only
-        heights = {std::atof(one)};
-        pitches = {std::atof(std::strchr(one, ',') + 1)};
+      if (!mount.empty()) {  // one mount only
+        heights = {mount[0]};
+        pitches = {mount[1]};
       }
       for (double h : heights) {
         for (double pitch_deg : pitches) {

@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   app.add_option("--engine", engine, "blender: workbench or cycles")->check(CLI::IsMember({"workbench", "cycles"}));
   app.add_option("--samples", samples, "blender: Cycles samples")->check(manisoft::cli::between(1, 4096));
   manisoft::cli::readable_errors(app, "render_dataset");
-  CLI11_PARSE(app, argc, argv);
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
     std::optional<ms::render::Camera> camera;
     if (!position.empty()) {

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "PGM picture to write");
   app.add_option("--scale", scale, "pixels per cell")->check(manisoft::cli::between(1, 64));
   manisoft::cli::readable_errors(app, "scene_reach_map");
-  CLI11_PARSE(app, argc, argv);
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
     auto statics = scene::make_scene_statics();
     const auto table = manisoft::world::tabletop_table();

@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   app.add_option("--last", last, "last trace row (inclusive)");
   app.add_flag("--masks", masks, "also write object-id masks (mask_<k>.png, flat colours)");
   manisoft::cli::readable_errors(app, "render_blender");
-  CLI11_PARSE(app, argc, argv);
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
   try {
     const tabletop::TabletopScene scene = tabletop::make_tabletop_scene();
     const io::Trace trace = io::read_trace(trace_path);

@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
   app.add_flag("--episode", episode, "render every --every-th trace row into DIR/frames, strip.png and episode.mp4 (ffmpeg)");
   app.add_option("--every", every, "with --episode: frame stride")->check(manisoft::cli::positive());
   manisoft::cli::readable_errors(app, "render_scene");
-  CLI11_PARSE(app, argc, argv);
+  if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
 
   try {
     if (episode && trace_path.empty()) manisoft::detail::fail("--episode needs --trace");

@@ -4,8 +4,8 @@ the file that could not be written, and leaves no output that looks complete.
 
     test_bad_inputs.py BIN_DIR SCRATCH_DIR
 
-BIN_DIR holds the example programs. rod_sim, reach_eval, scene_sample and render_scene are
-required (the tests build them); run_task, generate_dataset and pick_place_eval are checked when
+BIN_DIR holds the example programs. rod_sim, reach_eval, world_demo, asset_gallery, scene_sample
+and render_scene are required (the tests build them); run_task, generate_dataset and pick_place_eval are checked when
 they are there (builds that only check them for warnings do not make them). Every case is listed
 as it runs: program, input, exit status and the message's first line, and is a row of
 docs/bad-inputs.md (tests/bad_input_table.py): the sections of flags, scene files, traces and
@@ -131,6 +131,16 @@ def reach_eval_cases():
     refused(reach_eval, ["--seed", "1", "--targets", "1", "--out", "/dev/full"], ["writing '/dev/full' failed"], code=1)
     if reach_eval and "--load-kg" not in accepted(reach_eval, ["--help"]):
         failures.append("reach_eval --help does not list --load-kg")
+
+
+def other_program_cases():
+    world_demo, asset_gallery = program("world_demo"), program("asset_gallery")
+    out = scratch("world.csv")
+    refused(world_demo, ["--samples", "abc", "--map", "--out", out], ["--samples expects a number (got 'abc')"], [out], 2)
+    refused(world_demo, ["--samples", "0", "--map", "--out", out], ["--samples must be in [1, 1000000] (got 0)"], [out], 2)
+    refused(world_demo, ["--mount", "1", "--out", out], ["--mount"], [out], 2)
+    sheet = scratch("sheet.png")
+    refused(asset_gallery, ["--contact-sheet", sheet, "--columns", "0"], ["--columns must be in [1, 100] (got 0)"], [sheet], 2)
 
 
 WEIGHTS = Section("Weight files", """
@@ -299,6 +309,7 @@ def main():
     os.makedirs(SCRATCH)
     rod_sim_cases()
     reach_eval_cases()
+    other_program_cases()
     weight_cases()
     flag_cases()
     scenes = scene_file_cases()
