@@ -29,6 +29,7 @@
 #include <span>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "manisoft/control/model_executor.hpp"
@@ -224,30 +225,48 @@ py::array batch_view(std::span<const T> data, std::vector<py::ssize_t> shape, co
   return out;
 }
 
-/// The batched reach environment's compiled half (env/batched_reach_env.hpp); manisoft.make_vec_env
-/// wraps it with Gymnasium's vector API (manisoft_vec.py). Its arrays are numpy views of the batch's
-/// own buffers, kept alive by the object and overwritten by every reset and step.
-class ReachBatch {
+/// What the batches share from Python (env::BatchedReachEnv, task::BatchedTaskEnv): reset with a
+/// mask and a value per arm (its seed, or its scene index), step with a C-ordered float64 array,
+/// both without the GIL and from one thread at a time.
+template <typename Batch>
+class BatchHandle {
  public:
-  ReachBatch(int num_envs, int threads, const std::string& target_set, int horizon)
-      : batch_(num_envs, threads, reach_config(target_set, horizon), manisoft::rod::damping::AnalyticalLinear<double>(0.1)) {}
+  template <typename... Args>
+  explicit BatchHandle(Args&&... args) : batch_(std::forward<Args>(args)...) {}
 
-  /// Resets the arms with mask[i] (every arm when mask is None), arm i with seeds[i].
-  void reset(const Seeds& seeds, const std::optional<Flags>& mask) {
+  /// Resets the arms with mask[i] (every arm when mask is None), arm i with values[i].
+  void reset(const Seeds& values, const std::optional<Flags>& mask) {
     const auto entered = threads_.enter("reset");
     py::gil_scoped_release release;
+    const std::span<const std::uint64_t> v(values.data(), std::size_t(values.size()));
     if (mask)
-      batch_.reset(std::span<const std::uint8_t>(mask->data(), std::size_t(mask->size())), std::span<const std::uint64_t>(seeds.data(), std::size_t(seeds.size())));
+      batch_.reset(std::span<const std::uint8_t>(mask->data(), std::size_t(mask->size())), v);
     else
-      batch_.reset(std::span<const std::uint64_t>(seeds.data(), std::size_t(seeds.size())));
+      batch_.reset(v);
   }
 
-  /// One step of every arm: actions hold num_envs x rows x 3 float64 values (C order).
+  /// One step of every arm: actions hold num_envs x (one arm's action) float64 values (C order).
   void step(const Actions& actions) {
     const auto entered = threads_.enter("step");
     py::gil_scoped_release release;
     batch_.step(std::span<const double>(actions.data(), std::size_t(actions.size())));
   }
+
+  int num_envs() const { return batch_.batch_size(); }
+  int threads() const { return batch_.threads(); }
+
+ protected:
+  Batch batch_;
+  manisoft_py::ThreadUse threads_;
+};
+
+/// The batched reach environment's compiled half (env/batched_reach_env.hpp); manisoft.make_vec_env
+/// wraps it with Gymnasium's vector API (manisoft_vec.py). Its arrays are numpy views of the batch's
+/// own buffers, kept alive by the object and overwritten by every reset and step.
+class ReachBatch : public BatchHandle<manisoft::env::BatchedReachEnv<>> {
+ public:
+  ReachBatch(int num_envs, int threads, const std::string& target_set, int horizon)
+      : BatchHandle(num_envs, threads, reach_config(target_set, horizon), manisoft::rod::damping::AnalyticalLinear<double>(0.1)) {}
 
   /// The batch's arrays by name (views; the owner keeps the batch alive).
   static py::dict arrays(const py::object& owner) {
@@ -271,40 +290,17 @@ class ReachBatch {
     return d;
   }
 
-  int num_envs() const { return batch_.batch_size(); }
-  int threads() const { return batch_.threads(); }
   int action_rows() const { return batch_.action_rows(); }
   py::dict action_space() const { return reach_action_spec(batch_.arm(0)); }
   py::dict observation_space() const { return reach_observation_spec(batch_.arm(0)); }
-
- private:
-  manisoft::env::BatchedReachEnv<> batch_;
-  manisoft_py::ThreadUse threads_;
 };
 
 /// The batched task environment's compiled half (task/batched_task_env.hpp); manisoft.make_vec_env
 /// wraps it with Gymnasium's vector API (manisoft_vec.py). Its arrays are numpy views as ReachBatch's.
-class TaskBatch {
+class TaskBatch : public BatchHandle<manisoft::task::BatchedTaskEnv> {
  public:
   TaskBatch(const std::string& task, const std::string& setting, const std::string& split, std::uint64_t seed, int num_envs, int threads)
-      : batch_(num_envs, threads, settings(task, setting, split, seed)) {}
-
-  /// Resets the arms with mask[i] (every arm when mask is None), arm i on scene index indices[i].
-  void reset(const Seeds& indices, const std::optional<Flags>& mask) {
-    const auto entered = threads_.enter("reset");
-    py::gil_scoped_release release;
-    if (mask)
-      batch_.reset(std::span<const std::uint8_t>(mask->data(), std::size_t(mask->size())), std::span<const std::uint64_t>(indices.data(), std::size_t(indices.size())));
-    else
-      batch_.reset(std::span<const std::uint64_t>(indices.data(), std::size_t(indices.size())));
-  }
-
-  /// One step of every arm: actions hold num_envs x (3n + 1) float64 values (C order).
-  void step(const Actions& actions) {
-    const auto entered = threads_.enter("step");
-    py::gil_scoped_release release;
-    batch_.step(std::span<const double>(actions.data(), std::size_t(actions.size())));
-  }
+      : BatchHandle(num_envs, threads, settings(task, setting, split, seed)) {}
 
   static py::dict arrays(const py::object& owner) {
     const auto& b = owner.cast<const TaskBatch&>().batch_;
@@ -344,8 +340,6 @@ class TaskBatch {
     return out;
   }
 
-  int num_envs() const { return batch_.batch_size(); }
-  int threads() const { return batch_.threads(); }
   int n_elements() const { return batch_.n_elements(); }
   int max_objects() const { return batch_.max_objects(); }
   py::dict action_space() const { return manisoft_py::task_action_spec(batch_.n_elements()); }
@@ -359,9 +353,6 @@ class TaskBatch {
     s.seed = seed;
     return s;
   }
-
-  manisoft::task::BatchedTaskEnv batch_;
-  manisoft_py::ThreadUse threads_;
 };
 
 /// Renders any state of a scene: for replaying recorded states or a user's own.
