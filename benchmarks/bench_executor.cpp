@@ -15,8 +15,8 @@
 #include "manisoft/control/mlp_executor.hpp"
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/control/projected_executor.hpp"
-#include "manisoft/env/pick_place.hpp"
 #include "manisoft/env/reach_env.hpp"
+#include "manisoft/task/pick_place.hpp"
 
 namespace {
 
@@ -75,29 +75,40 @@ void BM_ModelExecutorSetup(benchmark::State& state) {
 }
 BENCHMARK(BM_ModelExecutorSetup)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->Iterations(300);
 
-/// Path set-up (track_line): the pick-and-place paths of 50 tasks (pre-grasp, grasp,
-/// carry, place), each planned from the end of the one before, the first from the settled home
-/// shape, with the held cube's payload from the carry on, as env::PickPlaceRunner plans them. The
+/// Path set-up (track_line): the pick-and-place lines of 50 drawn cube scenes (pre-grasp, grasp,
+/// carry, place; task/pick_place.hpp), each planned from the end of the one before, the first from
+/// the task environment's settled home shape, with the cube's payload from the carry on. The
 /// knots' inverse statics (with actuator relief) and the continuity checks. Also reports the
 /// slowest single set-up (max_cpu_us, process CPU time: a preempted set-up does not count its wait).
 void BM_TrackLineSetup(benchmark::State& state) {
-  manisoft::env::PickPlaceRunner runner;
+  namespace task = manisoft::task;
+  const manisoft::scene::AssetLibrary library;
+  manisoft::scene::SceneValidator validator(library);
+  task::TaskEnv env(library, task::pick_place_env_config());
+  task::Expert expert(env, task::pick_place_expert_config());
+  const double mass = library.get(task::pick_place_asset(task::PickPlaceObject::cube), "bench").mass;
   std::vector<std::array<manisoft::math::Pose<double>, 4>> paths;
   std::vector<Eigen::Vector3d> in_hand;
   for (std::uint64_t s = 0; s < 50; ++s) {
-    const auto task = runner.draw_task(100000 + s);
-    paths.push_back(runner.waypoints(task, Eigen::Vector3d::Zero()));
-    in_hand.push_back(runner.nominal_in_hand(task));
+    const auto draw = task::draw_pick_place(validator, expert, env, task::PickPlaceObject::cube, 100000 + s);
+    const Eigen::Vector3d half_up(0, 0, 0.0285);  // the grasp centre at the cube's centre
+    const auto grasp = env.tool_down(draw.object + half_up, draw.object_yaw), place = env.tool_down(draw.place + half_up, draw.object_yaw);
+    auto above = [](manisoft::math::Pose<double> p, double dz) {
+      p.translation.z() += dz;
+      return p;
+    };
+    paths.push_back({above(grasp, 0.06), grasp, above(place, 0.05), above(place, 0.008)});
+    in_hand.push_back(grasp.rotation.transpose() * (draw.object + half_up - grasp.translation));
   }
-  manisoft::control::ModelExecutor<double> executor = runner.home_executor();
+  manisoft::control::ModelExecutor<double> executor = env.home_executor();
   std::size_t i = 0;
   double slowest = 0;
   for (auto _ : state) {
     const std::size_t task = (i / 4) % paths.size(), leg = i % 4;
     if (leg == 0 || leg == 2) {
       state.PauseTiming();
-      if (leg == 0) executor = runner.home_executor();
-      if (leg == 2) executor.set_payload(runner.config().object_mass, in_hand[task]);
+      if (leg == 0) executor = env.home_executor();
+      if (leg == 2) executor.set_payload(mass, in_hand[task]);
       state.ResumeTiming();
     }
     const std::clock_t t0 = std::clock();

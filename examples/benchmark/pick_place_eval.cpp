@@ -1,5 +1,6 @@
-// pick_place_eval: the model executor as a trajectory tracker on a tabletop pick and place
-// (the routine is env::PickPlaceRunner, include/manisoft/env/pick_place.hpp).
+// pick_place_eval: the model executor as a trajectory tracker on a tabletop pick and place: the
+// expert runs a cube (or a drinks can) to a place point as an ALN episode in TaskEnv
+// (include/manisoft/task/pick_place.hpp).
 //
 //   pick_place_eval --episodes N --seed S [--mass KG] [--object cube|can] --out FILE.csv
 //
@@ -8,25 +9,24 @@
 //   {"episodes":N, "success_rate":..., "mean_steps":..., "max_steps":..., "mean_cpu_s":...,
 //    "max_node_speed":..., "max_path_ratio":..., "failures":{"reason":count,...}}
 // (steps over all episodes, successful or not; speeds in m/s; path ratio: measured end-effector
-// path over the straight distance, worst segment of any episode). The CSV has one row per episode.
-// Exit codes: 0 done, 1 refused configuration or failed run (no CSV is left: it is written under a
-// temporary name and renamed when complete), 2 bad flags (CLI11).
+// path over its straight displacement, worst executor line of any episode). The CSV has one row
+// per episode. Exit codes: 0 done, 1 refused configuration or failed run (no CSV is left: it is
+// written under a temporary name and renamed when complete), 2 bad flags.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cstdio>
 #include <exception>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <string>
 
 #include "../cli_checks.hpp"
 #include "../output_file.hpp"
-#include "manisoft/env/pick_place.hpp"
+#include "manisoft/task/pick_place.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"pick_place_eval: tabletop pick and place with the model executor as a trajectory tracker"};
+  CLI::App app{"pick_place_eval: tabletop pick and place by the expert, the model executor as a trajectory tracker"};
   int episodes = 20;
   long seed = 1;
   double mass = 0.1;
@@ -34,53 +34,48 @@ int main(int argc, char** argv) {
   app.add_option("--episodes", episodes, "episodes to run")->required()->check(manisoft::cli::between(1, 1e6));
   app.add_option("--seed", seed, "seed of the task set (episode i: seed * 100000 + i)")->required()->check(manisoft::cli::between(0, 1e9));
   app.add_option("--mass", mass, "object mass, kg (default 0.1)")->check(manisoft::cli::between(0.001, 5));
-  app.add_option("--object", object, "cube (5 cm) or can (r 3.3 cm, lying on its side)")->check(CLI::IsMember({"cube", "can"}));
+  app.add_option("--object", object, "cube (a 5.7 cm Rubik's cube) or can (a drinks can, r 3.3 cm, 12 cm, upright)")->check(CLI::IsMember({"cube", "can"}));
   app.add_option("--out", out, "per-episode CSV")->required();
   manisoft::cli::readable_errors(app, "pick_place_eval");
   if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
+  namespace task = manisoft::task;
   try {
     manisoft::cli::OutputFile file(out);
     std::ostream& csv = file.stream();
-    csv << "episode,seed,success,failure,steps,cpu_s,executor_s,max_setup_s,max_node_speed,max_path_ratio,max_planned_ratio,"
-           "place_error,tilt,grasp_step,release_step,object_x,object_y,object_yaw,place_x,place_y\n";
+    csv << "episode,seed,success,failure,steps,cpu_s,max_node_speed,fastest_step,max_path_ratio,ramps,place_error,tilt,grasp_step,release_step,draws,"
+           "object_x,object_y,object_yaw,place_x,place_y\n";
     csv.precision(9);
-    manisoft::env::PickPlaceConfig config;
-    config.object_mass = mass;
-    config.object = object == "can" ? manisoft::env::PickPlaceObject::can : manisoft::env::PickPlaceObject::cube;
-    manisoft::env::PickPlaceRunner runner(config);
-    std::printf("pick and place: %d episodes, seed %ld, %s %.3f kg (home reset: %d control steps, not counted)\n", episodes, seed, object.c_str(), mass,
-                runner.home_steps());
-    std::printf("%7s %8s %-13s %6s %7s %9s %8s %8s %9s\n", "episode", "success", "failure", "steps", "cpu_s", "node_m/s", "path_ratio",
-                "err_mm", "setup_ms");
-    int successes = 0, max_steps = 0;
-    long total_steps = 0;
-    double total_cpu = 0, max_speed = 0, max_ratio = 0, executor_s = 0, max_setup = 0;
+    const task::PickPlaceObject kind = object == "can" ? task::PickPlaceObject::can : task::PickPlaceObject::cube;
+    const manisoft::scene::AssetLibrary library(task::pick_place_catalog(kind, mass));
+    manisoft::scene::SceneValidator validator(library);
+    task::TaskEnv env(library, task::pick_place_env_config());
+    task::Expert expert(env, task::pick_place_expert_config());
+    std::printf("pick and place: %d episodes, seed %ld, %s %.3f kg\n", episodes, seed, object.c_str(), mass);
+    std::printf("%7s %8s %-13s %6s %7s %9s %10s %8s\n", "episode", "success", "failure", "steps", "cpu_s", "node_m/s", "path_ratio", "err_mm");
+    int successes = 0;
+    long total_steps = 0, max_steps = 0;
+    double total_cpu = 0, max_speed = 0, max_ratio = 0;
     std::map<std::string, int> failures;
     for (int i = 0; i < episodes; ++i) {
       const std::uint64_t s = std::uint64_t(seed) * 100000u + std::uint64_t(i);
-      const manisoft::env::PickPlaceResult r = runner.run(s);
+      const task::PickPlaceDraw draw = task::draw_pick_place(validator, expert, env, kind, s);
+      const task::PickPlaceResult r = task::run_pick_place(env, expert, draw);
       successes += r.success;
       total_steps += r.steps;
       max_steps = std::max(max_steps, r.steps);
       total_cpu += r.cpu_seconds;
-      executor_s += r.executor_seconds;
-      max_setup = std::max(max_setup, r.max_setup_seconds);
       max_speed = std::max(max_speed, r.max_node_speed);
       max_ratio = std::max(max_ratio, r.max_path_ratio);
       if (!r.success) ++failures[r.failure];
-      std::printf("%7d %8s %-13s %6d %7.3f %9.3f %10.3f %8.1f %9.3f\n", i, r.success ? "yes" : "no", r.success ? "-" : r.failure.c_str(),
-                  r.steps, r.cpu_seconds, r.max_node_speed, r.max_path_ratio, 1e3 * r.place_error, 1e3 * r.max_setup_seconds);
+      std::printf("%7d %8s %-13s %6ld %7.3f %9.3f %10.3f %8.1f\n", i, r.success ? "yes" : "no", r.success ? "-" : r.failure.c_str(), r.steps,
+                  r.cpu_seconds, r.max_node_speed, r.max_path_ratio, 1e3 * r.place_error);
       std::fflush(stdout);
-      csv << i << ',' << s << ',' << int(r.success) << ',' << (r.success ? "" : r.failure) << ',' << r.steps << ',' << r.cpu_seconds << ','
-          << r.executor_seconds << ',' << r.max_setup_seconds << ',' << r.max_node_speed << ',' << r.max_path_ratio << ','
-          << r.max_planned_ratio << ',' << r.place_error << ',' << r.tilt << ',' << r.grasp_step << ',' << r.release_step << ','
-          << r.task.object.x() << ',' << r.task.object.y() << ',' << r.task.object_yaw << ',' << r.task.place.x() << ',' << r.task.place.y()
-          << '\n';
+      csv << i << ',' << s << ',' << int(r.success) << ',' << r.failure << ',' << r.steps << ',' << r.cpu_seconds << ',' << r.max_node_speed << ',' << r.fastest_step << ','
+          << r.max_path_ratio << ',' << r.ramps << ',' << r.place_error << ',' << r.tilt << ',' << r.grasp_step << ',' << r.release_step << ',' << draw.draws << ','
+          << draw.object.x() << ',' << draw.object.y() << ',' << draw.object_yaw << ',' << draw.place.x() << ',' << draw.place.y() << '\n';
     }
     file.commit();
-    std::printf("executor: %.2f us per control step on average (CPU, path set-ups included), slowest path set-up %.3f ms\n",
-                1e6 * executor_s / double(std::max(1L, total_steps)), 1e3 * max_setup);
-    std::printf("{\"episodes\":%d, \"success_rate\":%.4f, \"mean_steps\":%.1f, \"max_steps\":%d, \"mean_cpu_s\":%.4f, \"max_node_speed\":%.4f, "
+    std::printf("{\"episodes\":%d, \"success_rate\":%.4f, \"mean_steps\":%.1f, \"max_steps\":%ld, \"mean_cpu_s\":%.4f, \"max_node_speed\":%.4f, "
                 "\"max_path_ratio\":%.4f, \"failures\":{",
                 episodes, double(successes) / episodes, double(total_steps) / episodes, max_steps, total_cpu / episodes, max_speed, max_ratio);
     bool first = true;

@@ -429,6 +429,8 @@ class ModelExecutor {
   bool path_done() const { return steps_ >= ramp_steps_; }
   /// Control steps since the current path (or ramp) started.
   long path_step() const { return steps_; }
+  /// Whether the current target is followed along a line (track_line), not a shape ramp (set_target).
+  bool tracking() const { return tracking_; }
   const PathReport<Scalar>& last_path() const { return last_path_; }
   /// The desired shape ((n + 1) x 3 node positions) `step` control steps into the current path
   /// (clamped to its end); for planners that check the whole arm against obstacles. Changes

@@ -13,6 +13,7 @@
 #include <string>
 #include <type_traits>
 #include <variant>
+#include <utility>
 #include <vector>
 
 #include "manisoft/assets/asset.hpp"
@@ -24,7 +25,10 @@ namespace manisoft::scene {
 
 class AssetLibrary {
  public:
-  AssetLibrary() : objects_(assets::object_catalog()), obstacles_(assets::obstacle_catalog()) {
+  AssetLibrary() : AssetLibrary(assets::object_catalog()) {}
+  /// A library of other objects (e.g. the catalogue with one asset's mass changed) and obstacles.
+  explicit AssetLibrary(std::vector<assets::Asset> objects, std::vector<assets::Asset> obstacles = assets::obstacle_catalog())
+      : objects_(std::move(objects)), obstacles_(std::move(obstacles)) {
     for (std::size_t i = 0; i < objects_.size(); ++i) index_.push_back({objects_[i].id, &objects_[i]});
     for (std::size_t i = 0; i < obstacles_.size(); ++i) index_.push_back({obstacles_[i].id, &obstacles_[i]});
     std::sort(index_.begin(), index_.end(), [](const Entry& a, const Entry& b) { return a.id < b.id; });
