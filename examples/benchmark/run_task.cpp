@@ -1,7 +1,8 @@
 // run_task: one expert episode of a ManiSoft task (include/manisoft/task/: TaskEnv + Expert).
 //   run_task --task COLL|ALN|STK|ARR --setting clean|randomized --index I --seed S
 //            [--split train|eval] [--scene scene.json] [--save-scene out.json] [--trace out.csv] [--quiet]
-//            [--torque-noise SIGMA --noise-hold K]
+//            [--torque-noise SIGMA --noise-hold K] [--expert-config expert.json]
+//            [--path-speed V] [--carry-speed V] [--max-retries N] [--no-arm-check]
 // Samples the scene (or reads --scene), prints the instruction and each waypoint as it is
 // reached, and ends its output with one line of JSON:
 //   {"task":..., "setting":..., "index":..., "seed":..., "success":true|false, "steps":N,
@@ -14,14 +15,18 @@
 // held (object index or -1), gripper pose (position, quaternion w x y z), every rod node, every
 // object's pose (object<i>_px..._qz). --save-scene writes the scene JSON. --torque-noise adds
 // Gaussian noise of that standard deviation to every entry of the expert's torques, redrawn every
-// --noise-hold control steps (a learner's error; seeded by the scene's index and seed). Exit 0 whether or not
-// the episode succeeds; 1 on an error (a malformed scene file, no valid scene), 2 on bad flags.
+// --noise-hold control steps (a learner's error; seeded by the scene's index and seed).
+// --expert-config reads the expert's settings from JSON, one object per group of ExpertConfig
+// (task/expert_config_json.hpp); the expert flags override it. Exit 0 whether or not the episode
+// succeeds; 1 on an error (a malformed scene or expert configuration file, no valid scene), 2 on
+// bad flags.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <ctime>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <string>
 #include <string_view>
@@ -30,6 +35,7 @@
 #include "manisoft/scene/scene_json.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/task/expert.hpp"
+#include "manisoft/task/expert_config_json.hpp"
 #include "manisoft/task/task_env.hpp"
 
 namespace scene = manisoft::scene;
@@ -42,7 +48,6 @@ int main(int argc, char** argv) {
   bool quiet = false;
   double noise_sigma = 0;
   int noise_hold = 1;
-  task::ExpertConfig expert_config;
   app.add_option("--task", task_name, "COLL, ALN, STK, ARR or OVR")->check(CLI::IsMember(scene::task_names()));
   app.add_option("--setting", setting, "clean or randomized")->check(CLI::IsMember({"clean", "randomized"}));
   app.add_option("--index", index, "scene index (>= 0)");
@@ -55,46 +60,28 @@ int main(int argc, char** argv) {
   app.add_option("--noise-hold", noise_hold, "control steps each noise draw is held (1: fresh every step)")->check(manisoft::cli::positive());
   app.add_option("--trace", trace_file, "CSV file: one row per control step (world_demo's layout)");
   app.add_flag("--quiet", quiet, "print only the JSON line");
-  app.add_option("--path-speed", expert_config.path_peak_speed, "expert: peak end-effector speed of a path with the gripper empty, m/s")->check(manisoft::cli::positive());
-  app.add_option("--node-speed", expert_config.max_node_speed, "expert: planned peak speed of any rod node with the gripper empty, m/s")->check(manisoft::cli::positive());
-  app.add_option("--carry-speed", expert_config.carry_peak_speed, "expert: peak end-effector speed while holding, m/s")->check(manisoft::cli::positive());
-  app.add_option("--carry-grip-share", expert_config.carry_grip_share, "expert: a held line accelerates the object at most this share of max_hold_force / mass (0: not bounded)")->check(manisoft::cli::non_negative());
-  app.add_option("--carry-node-speed", expert_config.carry_node_speed, "expert: planned peak node speed while holding, m/s")->check(manisoft::cli::positive());
-  app.add_option("--path-cruise", expert_config.path_cruise, "expert: fraction of a path at constant speed (0: quintic timing)")->check(manisoft::cli::between(0, 0.95));
-  app.add_option("--settle-speed", expert_config.settle_speed, "expert: close / open once the arm's tip is slower, m/s")->check(manisoft::cli::positive());
-  app.add_option("--start-error", expert_config.start_error, "expert: a chained path starts once the previous one is this near its end, m")->check(manisoft::cli::positive());
-  app.add_option("--via-error", expert_config.via_error, "expert: the same at an intermediate point of a leg (arc or via point), m")->check(manisoft::cli::positive());
-  app.add_option("--arm-clearance", expert_config.arm_clearance, "expert: the rod clear of objects and obstacles along planned lines, m")->check(manisoft::cli::non_negative());
+  std::string expert_file;
+  app.add_option("--expert-config", expert_file, "expert: JSON file of settings by group, e.g. {\"carry\": {\"peak_speed\": 1.2}} (docs/tasks.md); the flags below override it")
+      ->check(CLI::ExistingFile);
+  std::optional<double> path_speed, carry_speed;
+  std::optional<int> max_retries;
+  app.add_option("--path-speed", path_speed, "expert: peak end-effector speed of a path with the gripper empty, m/s (paths.peak_speed)")->check(manisoft::cli::positive());
+  app.add_option("--carry-speed", carry_speed, "expert: peak end-effector speed while holding, m/s (carry.peak_speed)")->check(manisoft::cli::positive());
+  app.add_option("--max-retries", max_retries, "expert: re-tries of a move whose grasp failed, each with another grasp (approach.max_retries)")->check(manisoft::cli::non_negative());
   bool no_arm_check = false;
-  app.add_flag("--no-arm-check", no_arm_check, "expert: do not check planned lines against objects and obstacles");
-  app.add_option("--stack-finger-clearance", expert_config.stack_finger_clearance, "expert: STK: the fingertips above the item below's top when released, m")->check(manisoft::cli::non_negative());
-  app.add_option("--place-clearance", expert_config.place_clearance, "expert: the object's bottom above its support when released, m")->check(manisoft::cli::non_negative());
-  app.add_option("--approach-distance", expert_config.approach_distance, "expert: approach pose distance from the grasp, m")->check(manisoft::cli::positive());
-  app.add_option("--settle-error", expert_config.settle_error, "expert: close / open once the end-effector is this near its pose, m")->check(manisoft::cli::positive());
-  app.add_option("--release-lift", expert_config.release_lift, "expert: a tall object is held this far above where its support took it before the release, m")->check(manisoft::cli::non_negative());
-  app.add_option("--contact-depth", expert_config.contact_depth, "expert: a tall object's lower line ends this far below its support, m")->check(manisoft::cli::non_negative());
-  app.add_option("--retract-speed", expert_config.retract_peak_speed, "expert: peak end-effector speed of the retract after a release, m/s")->check(manisoft::cli::positive());
-  app.add_option("--release-settle-speed", expert_config.release_settle_speed, "expert: a tall object is let go once the arm's tip is slower, m/s")->check(manisoft::cli::non_negative());
-  app.add_option("--lower-speed", expert_config.lower_peak_speed, "expert: peak end-effector speed of the lower line, m/s")->check(manisoft::cli::positive());
-  app.add_option("--carry-height", expert_config.carry_height, "expert: end-effector above the place pose before lowering, m")->check(manisoft::cli::non_negative());
-  app.add_option("--slow-lower", expert_config.slow_lower, "expert: a lower line longer than twice this runs at the carry's speed until this far above its end, m (0: all slow)")->check(manisoft::cli::non_negative());
-  app.add_option("--carry-settle-speed", expert_config.carry_settle_speed, "expert: lower only once the arm's tip is slower at the end of the carry, m/s (0: at once)")->check(manisoft::cli::non_negative());
-  app.add_option("--lift-height", expert_config.lift_height, "expert: straight up from the grasp first on a via carry, m")->check(manisoft::cli::non_negative());
-  app.add_option("--min-segment-steps", expert_config.min_segment_steps, "expert: shortest path, control steps")->check(manisoft::cli::positive());
-  app.add_option("--max-retries", expert_config.max_retries, "expert: re-tries of a move whose grasp failed, each with another grasp")->check(manisoft::cli::non_negative());
-  app.add_option("--grasp-error", expert_config.grasp_error, "expert: a descent that ends farther from its grasp pose backs off and re-tries, m")->check(manisoft::cli::positive());
-  app.add_option("--via-raise", expert_config.via_raise, "expert: the high variants of a grasp raise their via points this much, m")->check(manisoft::cli::non_negative());
-  app.add_flag("!--estimate-in-contact", expert_config.freeze_estimate_in_contact, "expert: keep the executor's stiffness estimate running while the tool may touch things (descend, close, lower, open)");
-  app.add_option("--tight-clearance", expert_config.tight_clearance, "expert: a grasp whose open fingers clear the object by less a side is descended to at --tight-speed, m (0: never)")->check(manisoft::cli::non_negative());
-  app.add_option("--tight-speed", expert_config.tight_peak_speed, "expert: peak end-effector speed of the descent to a tight grasp, m/s")->check(manisoft::cli::positive());
+  app.add_flag("--no-arm-check", no_arm_check, "expert: do not check planned lines against objects and obstacles (checks.objects false)");
   task::TaskEnvConfig env_config;
   app.add_option("--executor-damping", env_config.executor.damping_gain, "executor: node velocity feedback kd, 1/s")->check(manisoft::cli::non_negative());
   app.add_option("--executor-stiffness", env_config.executor.position_gain, "executor: node position feedback kp, 1/s^2")->check(manisoft::cli::non_negative());
   manisoft::cli::check_counts(app, {"--index", "--seed"});
   manisoft::cli::readable_errors(app, "run_task");
   if (const int code = manisoft::cli::parse(app, argc, argv); code >= 0) return code;  // 2 after a bad flag
-  expert_config.check_arm_clearance = !no_arm_check;
   try {
+    task::ExpertConfig expert_config = expert_file.empty() ? task::ExpertConfig{} : task::load_expert_config(expert_file);
+    if (path_speed) expert_config.paths.peak_speed = *path_speed;
+    if (carry_speed) expert_config.carry.peak_speed = *carry_speed;
+    if (max_retries) expert_config.approach.max_retries = *max_retries;
+    if (no_arm_check) expert_config.checks.objects = false;
     const std::clock_t c0 = std::clock();
     scene::SceneSampler sampler;
     scene::SceneSpec spec;

@@ -231,6 +231,15 @@ def flag_cases():
     refused(run_task, ["--task", "ALN", "--index", "-1"], ["--index must be >= 0 (got -1)"], code=2)
     refused(run_task, ["--task", "ALN", "--seed", "-1"], ["--seed must be >= 0 (got -1)"], code=2)
     refused(run_task, ["--task", "ALN", "--path-speed", "0"], ["--path-speed must be > 0 (got 0)"], code=2)
+    # an expert configuration file (task/expert_config_json.hpp): refused naming the file and the key
+    for name, text, words in [("unknown_key.json", '{"carry": {"speed": 1.2}}', "carry.speed is not a setting of the expert"),
+                              ("wrong_type.json", '{"settle": {"max_steps": 1.5}}', "settle.max_steps = 1.5 is invalid: it must be an integer"),
+                              ("negative_speed.json", '{"carry": {"peak_speed": -1}}', "ExpertConfig carry.peak_speed = -1 is invalid")]:
+        path = scratch(name)
+        with open(path, "w") as f:
+            f.write(text)
+        refused(run_task, ["--task", "ALN", "--expert-config", path, "--quiet"], [path + ": ", words], code=1,
+                shown=f"--task ALN --expert-config {name}: {text}")
     dataset = scratch("dataset")
     refused(generate_dataset, ["--tasks", "ALN", "--clean", "1", "--seed", "-1", "--out", dataset], ["--seed must be >= 0 (got -1)"], [dataset], 2)
     refused(generate_dataset, ["--tasks", "ALN", "--clean", "-1", "--out", dataset], ["--clean must be >= 0 (got -1)"], [dataset], 2)

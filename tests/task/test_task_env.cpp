@@ -8,13 +8,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <random>
 #include <string>
 
 #include "manisoft/scene/scene_sampler.hpp"
 #include "manisoft/task/expert.hpp"
+#include "manisoft/task/expert_config_json.hpp"
 #include "manisoft/task/task_env.hpp"
+#include "../support/scratch_dir.hpp"
 
 namespace test_task_env {  // per-file namespace: the group's tests build as one unity translation unit
 
@@ -267,18 +270,68 @@ TEST_CASE("no action sequence within the actuation limits diverges a task step",
 TEST_CASE("a bad expert setting is refused naming the field", "[tasks][expert]") {
   TaskEnv& e = env();
   manisoft::task::ExpertConfig c;
-  c.tight_peak_speed = -0.5;
-  CHECK_THROWS_WITH(Expert(e, c), Catch::Contains("ExpertConfig tight_peak_speed = -0.5") && Catch::Contains("> 0"));
+  c.approach.tight_peak_speed = -0.5;
+  CHECK_THROWS_WITH(Expert(e, c), Catch::Contains("ExpertConfig approach.tight_peak_speed = -0.5") && Catch::Contains("> 0"));
   c = {};
-  c.arm_clearance = std::nan("");
-  CHECK_THROWS_WITH(Expert(e, c), Catch::Contains("ExpertConfig arm_clearance = nan"));
+  c.checks.arm_clearance = std::nan("");
+  CHECK_THROWS_WITH(Expert(e, c), Catch::Contains("ExpertConfig checks.arm_clearance = nan"));
   c = {};
-  c.path_cruise = 1.0;
-  CHECK_THROWS_WITH(Expert(e, c), Catch::Contains("path_cruise = 1"));
+  c.paths.cruise = 1.0;
+  CHECK_THROWS_WITH(Expert(e, c), Catch::Contains("ExpertConfig paths.cruise = 1") && Catch::Contains("<= 0.95"));
   c = {};
-  c.max_retries = -1;
-  CHECK_THROWS_WITH(Expert(e, c), Catch::Contains("max_retries = -1"));
+  c.approach.max_retries = -1;
+  CHECK_THROWS_WITH(Expert(e, c), Catch::Contains("ExpertConfig approach.max_retries = -1"));
   CHECK_NOTHROW(Expert(e, {}));
+}
+
+TEST_CASE("the expert configuration reads from JSON by group and refuses what it does not have", "[tasks][expert]") {
+  using manisoft::task::ExpertConfig;
+  using manisoft::task::expert_config_from_json;
+  using nlohmann::json;
+  // a file names only what it changes; the rest keeps its default
+  const ExpertConfig partial = expert_config_from_json(json::parse(R"({"carry": {"peak_speed": 1.2}, "checks": {"objects": false}})"), "a.json");
+  CHECK(partial.carry.peak_speed == 1.2);
+  CHECK_FALSE(partial.checks.objects);
+  CHECK(partial.paths.peak_speed == 1.5);
+  CHECK(partial.settle.max_steps == 200);
+  // round trip: every setting written, in eight groups, and read back to the same values
+  ExpertConfig c;
+  c.lower.slow_distance = 0.04;
+  c.settle.max_steps = 150;
+  c.paths.ramp_fallback = false;
+  const json written = manisoft::task::to_json(c);
+  CHECK(written.size() == 8);
+  CHECK(written.at("lower").at("slow_distance") == 0.04);
+  CHECK(written.at("approach").size() == 7);
+  const ExpertConfig back = expert_config_from_json(written, "b.json");
+  CHECK(back.lower.slow_distance == 0.04);
+  CHECK(back.settle.max_steps == 150);
+  CHECK_FALSE(back.paths.ramp_fallback);
+  CHECK(back.carry.grip_share == 0.45);
+  CHECK(manisoft::task::to_json(back) == written);
+  // refused, naming the file and the key
+  CHECK_THROWS_WITH(expert_config_from_json(json::parse(R"({"carry": {"speed": 1}})"), "c.json"),
+                    Catch::Contains("c.json: carry.speed is not a setting"));
+  CHECK_THROWS_WITH(expert_config_from_json(json::parse(R"({"grasp": {"distance": 1}})"), "c.json"),
+                    Catch::Contains("c.json: grasp.distance is not a setting"));
+  CHECK_THROWS_WITH(expert_config_from_json(json::parse(R"({"carry": {"peak_speed": -1}})"), "d.json"),
+                    Catch::Contains("d.json: ExpertConfig carry.peak_speed = -1") && Catch::Contains("> 0"));
+  CHECK_THROWS_WITH(expert_config_from_json(json::parse(R"({"paths": {"cruise": 1.5}})"), "d.json"),
+                    Catch::Contains("d.json: ExpertConfig paths.cruise = 1.5") && Catch::Contains("<= 0.95"));
+  CHECK_THROWS_WITH(expert_config_from_json(json::parse(R"({"settle": {"max_steps": 1.5}})"), "e.json"),
+                    Catch::Contains("e.json: settle.max_steps = 1.5") && Catch::Contains("an integer"));
+  CHECK_THROWS_WITH(expert_config_from_json(json::parse(R"({"settle": {"max_steps": 3000000000}})"), "e.json"),
+                    Catch::Contains("e.json: settle.max_steps = 3000000000") && Catch::Contains("int"));
+  CHECK_THROWS_WITH(expert_config_from_json(json::parse(R"({"checks": {"objects": 0}})"), "e.json"),
+                    Catch::Contains("e.json: checks.objects = 0") && Catch::Contains("true or false"));
+  CHECK_THROWS_WITH(expert_config_from_json(json::parse(R"({"carry": 1.2})"), "e.json"), Catch::Contains("e.json: carry must be an object"));
+  // from a file: a key given twice and a syntax error name the file
+  const auto dir = manisoft::test::scratch_dir("expert_config_json");
+  const std::string twice = (dir / "twice.json").string(), broken = (dir / "broken.json").string();
+  std::ofstream(twice) << R"({"carry": {"peak_speed": 1.2, "peak_speed": 1.0}})";
+  std::ofstream(broken) << R"({"carry": {"peak_speed": 1.2)";
+  CHECK_THROWS_WITH(manisoft::task::load_expert_config(twice), Catch::Contains(twice) && Catch::Contains("carry.peak_speed: duplicate key"));
+  CHECK_THROWS_WITH(manisoft::task::load_expert_config(broken), Catch::Contains(broken) && Catch::Contains("not valid JSON"));
 }
 
 TEST_CASE("an expert episode is deterministic: two runs give bit-identical states", "[tasks][expert]") {
@@ -308,7 +361,7 @@ TEST_CASE("the expert does not plan the arm through an obstacle in its way", "[t
   for (const bool check : {true, false}) {
     CAPTURE(check);
     manisoft::task::ExpertConfig config;
-    config.check_arm_clearance = check;
+    config.checks.objects = check;
     TaskEnv& e = env();
     Expert expert(e, config);
     run_expert(e, expert, s);
@@ -399,7 +452,7 @@ TEST_CASE("the open fingers come down onto a tall object from above and do not k
 }
 
 TEST_CASE("the expert descends to a tight grasp slowly and stacks two plates", "[tasks][expert]") {
-  // STK clean 2: two plates, whose grasps leave less than tight_clearance between each open finger
+  // STK clean 2: two plates, whose grasps leave less than approach.tight_clearance between each open finger
   // and the rim. A fast descent sways the arm sideways by about as much and tips the plate.
   const SceneSpec s = sample(Task::stk, 2);
   TaskEnv& e = env();
@@ -409,7 +462,7 @@ TEST_CASE("the expert descends to a tight grasp slowly and stacks two plates", "
     const auto& asset = sampler().library().get(o.asset_id, "test");
     CAPTURE(o.asset_id);
     REQUIRE(asset.grasps.size() > 0);
-    for (const auto& g : asset.grasps) CHECK(0.5 * (e.gripper_parameters().open_width - g.width) < config.tight_clearance);
+    for (const auto& g : asset.grasps) CHECK(0.5 * (e.gripper_parameters().open_width - g.width) < config.approach.tight_clearance);
   }
   double descend_peak = 0;  // m/s, the end-effector's downward speed over the descend phase, one control step apart
   int descend_steps = 0;
@@ -425,10 +478,10 @@ TEST_CASE("the expert descends to a tight grasp slowly and stacks two plates", "
   CAPTURE(expert.failure().value_or(""), manisoft::task::to_string(e.info().failure), descend_steps);
   CHECK(e.info().success);
   REQUIRE(descend_steps > 0);
-  // a plate is grasped from above; the descent's planned peak is tight_peak_speed (0.6 m/s;
-  // path_peak_speed, 1.5 m/s, for a loose grasp): tracking may overshoot the plan a little, not
+  // a plate is grasped from above; the descent's planned peak is approach.tight_peak_speed (0.6 m/s;
+  // paths.peak_speed, 1.5 m/s, for a loose grasp): tracking may overshoot the plan a little, not
   // by a factor of 2.5 (the arm still sways sideways from the approach as the descent begins)
-  CHECK(descend_peak < 1.5 * config.tight_peak_speed);
+  CHECK(descend_peak < 1.5 * config.approach.tight_peak_speed);
 }
 
 TEST_CASE("a stack of three fits the horizon: two moves with the task world's executor", "[tasks][expert]") {
@@ -450,9 +503,9 @@ TEST_CASE("a stack of three fits the horizon: two moves with the task world's ex
 
 TEST_CASE("a held line's acceleration stays within the grip: a tall bottle is not dropped at the lift", "[tasks][expert]") {
   // ARR clean 44: the bottle is grasped high; the carry starts with a 6 cm lift. Timed by the
-  // carry's speed alone (carry_grip_share 0) the lift's 60 control steps accelerated it at about
+  // carry's speed alone (carry.grip_share 0) the lift's 60 control steps accelerated it at about
   // 10 g and the weld's force passed the grip's max_hold_force (40 N): it slipped out (before the
-  // fingers moved; it now holds at a different grasp). Bounded to carry_grip_share x
+  // fingers moved; it now holds at a different grasp). Bounded to carry.grip_share x
   // max_hold_force / mass, the lift takes longer: the weld's force over the carry is lower than
   // unbounded, within the grip, and the bottle stays held and ends in the row, at rest (it rocks
   // on its base for about 230 control steps after the release, so success comes at the horizon
@@ -474,7 +527,7 @@ TEST_CASE("a held line's acceleration stays within the grip: a tall bottle is no
     return c;
   };
   manisoft::task::ExpertConfig unbounded;
-  unbounded.carry_grip_share = 0;
+  unbounded.carry.grip_share = 0;
   const Carry fast = carry(unbounded);
   const Carry bounded = carry({});
   CAPTURE(fast.max_force, bounded.max_force, manisoft::task::to_string(e.info().failure));
@@ -487,7 +540,7 @@ TEST_CASE("a held line's acceleration stays within the grip: a tall bottle is no
 TEST_CASE("the arm leaves a released tall object only once the opening fingers clear it", "[tasks][expert]") {
   // Fingers still on the object as the arm moves off drag it along; with a noisy arm a tall one
   // tips over (ALN with torque noise: bottles and candle sticks left lying). After S = 0 the arm
-  // holds still over a tall object until the gap exceeds the grasp's by release_clearance on each
+  // holds still over a tall object until the gap exceeds the grasp's by release.clearance on each
   // side: measured against the gap the fingers stopped at on the object in the carry, less one
   // step's opening (the fingers open at open_width / stroke_time). From a low object (a shoe)
   // it leaves at once.
@@ -523,7 +576,7 @@ TEST_CASE("the arm leaves a released tall object only once the opening fingers c
   };
   const Release bottle = release(2);  // ALN clean 2: a bottle (tall)
   REQUIRE(bottle.object.rfind("bottle/", 0) == 0);
-  const double clearance = manisoft::task::ExpertConfig{}.release_clearance;
+  const double clearance = manisoft::task::ExpertConfig{}.release.clearance;
   const auto gripper = e.world().gripper().parameters();  // the world exists once reset
   const double step_opening = gripper.open_width / gripper.stroke_time * e.control_dt();
   CAPTURE(bottle.held_gap, bottle.gap_at_retract, bottle.open_steps, bottle.rise_while_open, step_opening);
@@ -558,9 +611,9 @@ TEST_CASE("the carry lifts the held object and the gripper over the container's 
   // At the carry speed this scene was found with (1.2 m/s; at the default 1.5 the unchecked carry
   // only nudges the basket 4 mm).
   manisoft::task::ExpertConfig checked;
-  checked.carry_peak_speed = checked.carry_node_speed = 1.2;
+  checked.carry.peak_speed = checked.carry.node_speed = 1.2;
   manisoft::task::ExpertConfig unchecked = checked;
-  unchecked.check_arm_clearance = false;
+  unchecked.checks.objects = false;
   CHECK(container_travel(unchecked) > 0.05);
   const double travel = container_travel(checked);
   CAPTURE(manisoft::task::to_string(e.info().failure));
@@ -569,15 +622,15 @@ TEST_CASE("the carry lifts the held object and the gripper over the container's 
 }
 
 TEST_CASE("a descent that ends short of its grasp backs off and re-tries with another grasp", "[tasks][expert]") {
-  // COLL clean 3 (a cup and a basket) with grasp_error so small that every descent counts as
+  // COLL clean 3 (a cup and a basket) with approach.grasp_error so small that every descent counts as
   // blocked: the first backs off along its approach with the gripper open and the move is planned
   // again without that grasp (the cup's next yaw); the second, with no re-try left, closes.
   const SceneSpec s = sample(Task::coll, 3);
   const std::size_t cup = static_cast<std::size_t>(s.goal.object);
   TaskEnv& e = env();
   manisoft::task::ExpertConfig config;
-  config.grasp_error = 1e-5;
-  config.max_retries = 1;
+  config.approach.grasp_error = 1e-5;
+  config.approach.max_retries = 1;
   Expert expert(e, config);
   std::vector<manisoft::task::ExpertPhase> phases;
   std::vector<Eigen::Matrix3d> descent_ends;  // the cup's frame in the gripper's as each descent ends

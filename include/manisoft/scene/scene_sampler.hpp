@@ -94,7 +94,7 @@ struct SamplerSettings {
   double relation_margin = 0.02;    ///< m: the ARR spot holds with margins this much tighter, the start fails with them this much wider
   int min_obstacles = 3, max_obstacles = 10;
   /// OVR: the obstacle between is at least this tall (above the table top), well over the
-  /// expert's lift_height with its clearances, so a carry straight across would hit it, and at
+  /// expert's carry.lift_height with its clearances, so a carry straight across would hit it, and at
   /// most ovr_max_obstacle_height (the arm's reach above it with the object held).
   double ovr_min_obstacle_height = 0.15;  ///< m
   double ovr_max_obstacle_height = 0.25;  ///< m

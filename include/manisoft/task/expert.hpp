@@ -11,28 +11,29 @@
 // (expert_legs.hpp) pass the line checks (expert_checks.hpp), and runs it through a phase
 // machine, one handler per phase:
 //   approach  the approach leg's lines in turn;
-//   descend   to the grasp (at tight_peak_speed when the grasp is tight: tight_clearance);
-//   close     once settled (the arm's tip slower than settle_speed); the place corrected for
+//   descend   to the grasp (at approach.tight_peak_speed when the grasp is tight:
+//             approach.tight_clearance);
+//   close     once settled (the arm's tip slower than settle.speed); the place corrected for
 //             where the object sits in the hand, with the target orientation's symmetric
 //             equivalent nearest the held one, and the corrected carry checked again (when
 //             refused, the other kind of carry tried);
-//   carry     the carry leg's lines, then, once the arm's tip is slower than carry_settle_speed,
-//   lower     at lower_peak_speed (a long lower into a container at the carry's speed until
-//             slow_lower above its end first); a tall object (height above tall_ratio x width)
-//             is lowered on until its support carries it, contact_depth below, the arm stopped
-//             there, release_lift up;
+//   carry     the carry leg's lines, then, once the arm's tip is slower than carry.settle_speed,
+//   lower     at lower.peak_speed (a long lower into a container at the carry's speed until
+//             lower.slow_distance above its end first); a tall object (height above
+//             release.tall_ratio x width) is lowered on until its support carries it,
+//             lower.contact_depth below, the arm stopped there, release.lift up;
 //   open      once settled, or as soon as the support carries the object or the gripper touches
 //             anything else (fingers_blocked; a tall one once the arm's tip is slower than
-//             release_settle_speed);
-//   retract   (a tall object: once the opening fingers clear it by release_clearance on each
-//             side) up at retract_peak_speed until the fingertips clear the object's top, also
+//             release.settle_speed);
+//   retract   (a tall object: once the opening fingers clear it by release.clearance on each
+//             side) up at retract.peak_speed until the fingertips clear the object's top, also
 //             after the last move; then the next move.
-// A missed grasp re-opens and retries the move from its approach (max_retries); so does, backing
-// off along its approach with the gripper open, a descent that ends grasp_error short of its
-// grasp or a grasp whose carry no longer passes from where the object sits in the hand, the move
-// then planned without that grasp. A line the executor refuses while running (it starts from
-// where the arm's shape target is, not the planned pose) falls back to a shape ramp. The
-// executor's stiffness estimate is frozen while the tool may touch something (descend, close,
+// A missed grasp re-opens and retries the move from its approach (approach.max_retries); so does,
+// backing off along its approach with the gripper open, a descent that ends approach.grasp_error
+// short of its grasp or a grasp whose carry no longer passes from where the object sits in the
+// hand, the move then planned without that grasp. A line the executor refuses while running (it
+// starts from where the arm's shape target is, not the planned pose) falls back to a shape ramp.
+// The executor's stiffness estimate is frozen while the tool may touch something (descend, close,
 // lower, open: ModelExecutor::freeze_estimate).
 // Deterministic; allocation only when a move is planned, its carry re-checked at the grasp or a
 // ramp set up (path set-ups copy the executor).
@@ -114,14 +115,13 @@ class Expert : private detail::GraspChoice {
     const std::vector<Candidate> candidates = grasp_candidates(object, target, support_of(k), executor_.statics().desired_tip_pose());
     plan_refusal_ = candidates.empty() ? "the asset has no grasp annotation" : "";
     // first pass: straight lines only; second: refused lines repaired (check_leg)
-    plan_object_ = object;
     for (int pass = 0; pass < 2; ++pass) {
-      repair_ = pass == 1;
+      const detail::LinePlan lines(object, pass == 1);
       // (a re-try, whose first grasp failed, searches straight lines only: the repair pass checks
       // every candidate again, about 0.5 s when none passes)
-      if (repair_ && (!config_.ramp_fallback || retries_ > 0)) break;
+      if (lines.repair && (!config_.paths.ramp_fallback || retries_ > 0)) break;
       for (auto c : candidates) {
-        if (check_candidate(c.plan, k, executor_)) {
+        if (check_candidate(c.plan, k, executor_, lines)) {
           plan_ = c.plan;
           return true;
         }
@@ -146,7 +146,7 @@ class Expert : private detail::GraspChoice {
   }
   void enter(ExpertPhase p) {
     phase_ = p;
-    executor_.freeze_estimate(config_.freeze_estimate_in_contact && (p == ExpertPhase::descend || p == ExpertPhase::close ||
+    executor_.freeze_estimate(config_.paths.freeze_estimate_in_contact && (p == ExpertPhase::descend || p == ExpertPhase::close ||
                                                                      p == ExpertPhase::lower || p == ExpertPhase::open));
     if (events_.size() < events_.capacity()) {
       ExpertEvent e;
@@ -158,9 +158,9 @@ class Expert : private detail::GraspChoice {
     }
   }
   /// Backs off along the descent to the approach pose (gripper open) and plans the move again
-  /// without this grasp (max_retries); false, nothing changed, when no re-try is left.
+  /// without this grasp (approach.max_retries); false, nothing changed, when no re-try is left.
   bool retry_with_another_grasp() {
-    if (retries_ >= config_.max_retries || plan_.object < 0) return false;
+    if (retries_ >= config_.approach.max_retries || plan_.object < 0) return false;
     ++retries_;
     s_ = 0;
     excluded_.push_back(state_of(plan_.object).pose.inverse() * plan_.grasp);
@@ -177,10 +177,10 @@ class Expert : private detail::GraspChoice {
     const double distance = (goal.translation - executor_.statics().desired_tip_pose().translation).norm();
     const bool loaded = s_ == 1;
     const int steps = line_steps(distance, loaded, peak_speed, plan_.object);
-    const auto report = executor_.track_line(goal, steps, node_step(loaded), config_.path_cruise);
+    const auto report = executor_.track_line(goal, steps, node_step(loaded), config_.paths.cruise);
     if (!report.accepted) {
       // the executor's shape ramp to the goal's cold solution instead, when it has one
-      if (config_.ramp_fallback && start_ramp(goal)) return true;
+      if (config_.paths.ramp_fallback && start_ramp(goal)) return true;
       if (required) give_up(report.reason);
       return false;
     }
@@ -206,26 +206,27 @@ class Expert : private detail::GraspChoice {
     }
     if (!start_ramp(leg.pose[k])) give_up("a ramp target has no inverse statics solution within the actuation limits");
   }
-  /// Whether the held object is let go only once the arm is still (release_settle_speed): a
+  /// Whether the held object is let go only once the arm is still (release.settle_speed): a
   /// tall one.
-  bool release_settles() const { return config_.release_settle_speed > 0 && is_tall(plan_.object); }
-  /// The end of the lower line: the place pose; for a tall object (release_settles()) lowered
-  /// on by place_clearance + contact_depth, so that it reaches its support and is not dropped.
-  /// Onto an item (SupportKind::onto: STK): no lower than where the fingertips are stack_finger_clearance above the item below's
-  /// top (the closed fingers, at the held item's width, would land on its rim or inner wall
-  /// before the held item nests); the item drops the rest of the way.
+  bool release_settles() const { return config_.release.settle_speed > 0 && is_tall(plan_.object); }
+  /// The end of the lower line: the place pose; for a tall object (release_settles()) lowered on by
+  /// lower.place_clearance + lower.contact_depth, so that it reaches its support and is not
+  /// dropped. Onto an item (SupportKind::onto: STK): no lower than where the fingertips are
+  /// lower.stack_finger_clearance above the item below's top (the closed fingers, at the held
+  /// item's width, would land on its rim or inner wall before the held item nests); the item drops
+  /// the rest of the way.
   Pose lower_goal() const {
     Pose p = plan_.place;
-    if (release_settles() && config_.contact_depth > 0) p.translation.z() -= config_.place_clearance + config_.contact_depth;
+    if (release_settles() && config_.lower.contact_depth > 0) p.translation.z() -= config_.lower.place_clearance + config_.lower.contact_depth;
     if (const Support below = support_of(move_); below.kind == SupportKind::onto) {
-      const double lowest = top_of(below.object) + config_.stack_finger_clearance;
+      const double lowest = top_of(below.object) + config_.lower.stack_finger_clearance;
       p.translation.z() += std::max(0.0, lowest - fingertips(p).z());
     }
     return p;
   }
   /// Whether something under the held object carries it (see the lower phase).
   bool supported(const ObjectState& o) const {
-    return o.touching != 0 || o.touches_table || o.pose.translation.z() < plan_.object_target.translation.z() - 0.5 * config_.place_clearance;
+    return o.touching != 0 || o.touches_table || o.pose.translation.z() < plan_.object_target.translation.z() - 0.5 * config_.lower.place_clearance;
   }
   /// Whether the gripper touches anything but the held object: the closed fingers, at the held
   /// object's width, land on the rim or inner wall of a bowl below before the held bowl nests in
@@ -238,23 +239,23 @@ class Expert : private detail::GraspChoice {
     }
     return false;
   }
-  /// Above the place pose by retract_height, or more until the fingertips are finger_clearance
-  /// above the released object's top.
+  /// Above the place pose by retract.height, or more until the fingertips are
+  /// retract.finger_clearance above the released object's top.
   Pose retract_pose() const {
     Pose up = plan_.place;
-    up.translation.z() += std::max(config_.retract_height, top_of(plan_.object) + config_.finger_clearance - fingertips(plan_.place).z());
+    up.translation.z() += std::max(config_.retract.height, top_of(plan_.object) + config_.retract.finger_clearance - fingertips(plan_.place).z());
     return up;
   }
-  /// Whether the open fingers clear the object by less than tight_clearance on each side (a
-  /// plate, a bowl, a shoe): the arm then descends at tight_peak_speed, since its sideways sway
-  /// on a fast descent lands a finger on the object's rim and tips it.
+  /// Whether the open fingers clear the object by less than approach.tight_clearance on each side
+  /// (a plate, a bowl, a shoe): the arm then descends at approach.tight_peak_speed, since its
+  /// sideways sway on a fast descent lands a finger on the object's rim and tips it.
   bool tight_grasp() const {
-    return 0.5 * (env_->gripper_parameters().open_width - plan_.width) < config_.tight_clearance;
+    return 0.5 * (env_->gripper_parameters().open_width - plan_.width) < config_.approach.tight_clearance;
   }
 
   /// How near the end of line leg_ of `leg` the arm must be for the next path to start:
-  /// via_error at an arc or via point, start_error at the leg's last pose.
-  double chain_error(const Leg& leg) const { return leg_ + 1 < leg.count ? config_.via_error : config_.start_error; }
+  /// paths.via_error at an arc or via point, paths.start_error at the leg's last pose.
+  double chain_error(const Leg& leg) const { return leg_ + 1 < leg.count ? config_.paths.via_error : config_.paths.start_error; }
   /// What the phase handlers read of the world after a control step.
   struct Tick {
     const TaskEnv::World& world;
@@ -262,7 +263,7 @@ class Expert : private detail::GraspChoice {
     double error;    ///< m: the end-effector from its target
     double speed;    ///< m/s: the arm's tip
     bool done;       ///< the executor's path is complete
-    bool settled;    ///< done, slower than settle_speed and within settle_error
+    bool settled;    ///< done, slower than settle.speed and within settle.error
     bool holding;    ///< the gripper holds the moved object
   };
   Tick observe_tick(const TaskEnv::World& w) const {
@@ -271,7 +272,7 @@ class Expert : private detail::GraspChoice {
     const auto& v = w.rod().state().velocities;
     const double speed = v.row(v.rows() - 1).norm();
     const bool done = executor_.path_done();
-    const bool settled = done && speed < config_.settle_speed && error < config_.settle_error;
+    const bool settled = done && speed < config_.settle.speed && error < config_.settle.error;
     const auto held = w.gripper().held();
     const bool holding = held && plan_.object >= 0 && *held == env_->bodies().objects[static_cast<std::size_t>(plan_.object)];
     return Tick{w, Pose{f.rotation, f.position}, error, speed, done, settled, holding};
@@ -287,7 +288,7 @@ class Expert : private detail::GraspChoice {
       case ExpertPhase::lower: advance_lower(t); break;
       case ExpertPhase::open: advance_open(t); break;
       case ExpertPhase::retract:
-        if (t.done && t.error < config_.start_error) begin_move();
+        if (t.done && t.error < config_.paths.start_error) begin_move();
         break;
       case ExpertPhase::idle:
       case ExpertPhase::failed: break;
@@ -301,15 +302,15 @@ class Expert : private detail::GraspChoice {
       return;
     }
     enter(ExpertPhase::descend);
-    start_path(plan_.grasp, true, tight_grasp() ? config_.tight_peak_speed : 0.0);
+    start_path(plan_.grasp, true, tight_grasp() ? config_.approach.tight_peak_speed : 0.0);
   }
   /// Descend: at the grasp once settled, close.
   void advance_descend(const Tick& t) {
-    if (!(t.done && (t.settled || ++waited_ > config_.max_settle_steps))) return;
+    if (!(t.done && (t.settled || ++waited_ > config_.settle.max_steps))) return;
     waited_ = 0;
     // blocked short of the grasp (a finger on the object): the hand would close around
     // the object askew, and its carry is then mostly beyond the actuation limits
-    if (t.error > config_.grasp_error && retry_with_another_grasp()) return;
+    if (t.error > config_.approach.grasp_error && retry_with_another_grasp()) return;
     s_ = 1;
     enter(ExpertPhase::close);
   }
@@ -319,7 +320,7 @@ class Expert : private detail::GraspChoice {
     if (!t.holding && t.world.gripper().closing()) return;  // the fingers are still on their way
     if (!t.holding) {
       s_ = 0;
-      if (retries_++ < config_.max_retries) {
+      if (retries_++ < config_.approach.max_retries) {
         begin_move();
       } else {
         give_up("missed grasp");
@@ -330,7 +331,7 @@ class Expert : private detail::GraspChoice {
     correct_place(t.ee, object);
     // neither carry passes from where the object sits in the hand: put it back (it still
     // stands where it was grasped) and re-try with another grasp
-    if (!recheck_carry(t.ee, object) && retries_ < config_.max_retries) {
+    if (!recheck_carry(t.ee, object) && retries_ < config_.approach.max_retries) {
       executor_.set_payload(0.0);
       retry_with_another_grasp();
       return;
@@ -362,11 +363,11 @@ class Expert : private detail::GraspChoice {
       Plan checked = plan_;
       checked.via_carry = via;
       set_carry_leg(checked);
-      repair_ = true;
       planner_ = executor_;
       planner_.complete_path();
+      const detail::LinePlan lines(plan_.object, true);
       const char* why = "";
-      if (check_carry_leg(checked, ee, object, support_of(move_).object, why) && check_line(checked.place, why)) {
+      if (check_carry_leg(checked, ee, object, support_of(move_).object, lines, why) && check_line(checked.place, lines, why)) {
         plan_ = checked;
         return true;
       }
@@ -374,7 +375,7 @@ class Expert : private detail::GraspChoice {
     return false;
   }
   /// Carry: the carry leg's lines in turn, then (once the arm's tip is slower than
-  /// carry_settle_speed) the lower.
+  /// carry.settle_speed) the lower.
   void advance_carry(const Tick& t) {
     if (!t.holding) {
       give_up("dropped the object");
@@ -383,17 +384,18 @@ class Expert : private detail::GraspChoice {
     if (!(t.done && t.error < chain_error(plan_.carry_leg))) return;
     if (leg_ + 1 < plan_.carry_leg.count) {
       start_leg(plan_.carry_leg, ++leg_);
-    } else if (!(config_.carry_settle_speed > 0) || t.speed < config_.carry_settle_speed || ++waited_ > config_.max_settle_steps) {
+    } else if (!(config_.carry.settle_speed > 0) || t.speed < config_.carry.settle_speed || ++waited_ > config_.settle.max_steps) {
       waited_ = 0;
       enter(ExpertPhase::lower);
-      // a long lower (into a container) runs at the carry's speed to slow_lower above its end first
+      // a long lower (into a container) runs at the carry's speed to lower.slow_distance above its
+      // end first
       Pose fast = lower_goal();
-      fast.translation.z() += config_.slow_lower;
-      lower_fast_ = config_.slow_lower > 0 && target_.translation.z() - fast.translation.z() > config_.slow_lower;
-      start_path(lower_fast_ ? fast : lower_goal(), true, lower_fast_ ? 0.0 : config_.lower_peak_speed);
+      fast.translation.z() += config_.lower.slow_distance;
+      lower_fast_ = config_.lower.slow_distance > 0 && target_.translation.z() - fast.translation.z() > config_.lower.slow_distance;
+      start_path(lower_fast_ ? fast : lower_goal(), true, lower_fast_ ? 0.0 : config_.lower.peak_speed);
     }
   }
-  /// Lower: the fast line first (slow_lower), then the slow one; open once the object is
+  /// Lower: the fast line first (lower.slow_distance), then the slow one; open once the object is
   /// supported (or the fingers blocked) or the lower settled.
   void advance_lower(const Tick& t) {
     if (!t.holding) {
@@ -401,11 +403,11 @@ class Expert : private detail::GraspChoice {
       return;
     }
     if (lower_fast_ && !supported(state_of(plan_.object))) {
-      if (t.done && t.error < config_.start_error) {
+      if (t.done && t.error < config_.paths.start_error) {
         lower_fast_ = false;
-        // refused: the object is slow_lower above its release height already (into a
+        // refused: the object is lower.slow_distance above its release height already (into a
         // container: mostly below the rim), so it is let go from here once settled
-        start_path(lower_goal(), false, config_.lower_peak_speed);
+        start_path(lower_goal(), false, config_.lower.peak_speed);
       }
       return;
     }
@@ -413,19 +415,19 @@ class Expert : private detail::GraspChoice {
     // Its support already carries the object (it touches the table or another object, or
     // sank half the clearance below the release height): open now rather than press it in
     // until it slips.
-    // With release_settle_speed, the arm stops where it is first and opens once its tip is
+    // With release.settle_speed, the arm stops where it is first and opens once its tip is
     // slower (a tall object let go while the arm still sways tips over).
     if (!touched_ && (supported(state_of(plan_.object)) || fingers_blocked(t.world))) {
       touched_ = true;
       waited_ = 0;
       if (release_settles()) {
         Pose hold = t.ee;  // where the arm is, lifted so it does not press on
-        hold.translation.z() += config_.release_lift;
+        hold.translation.z() += config_.release.lift;
         start_path(hold, false);
       }
     }
-    if (touched_ ? (!release_settles() || t.speed < config_.release_settle_speed || ++waited_ > config_.max_settle_steps)
-                 : (t.done && (t.settled || ++waited_ > config_.max_settle_steps))) {
+    if (touched_ ? (!release_settles() || t.speed < config_.release.settle_speed || ++waited_ > config_.settle.max_steps)
+                 : (t.done && (t.settled || ++waited_ > config_.settle.max_steps))) {
       touched_ = false;
       waited_ = 0;
       s_ = 0;
@@ -433,11 +435,11 @@ class Expert : private detail::GraspChoice {
       enter(ExpertPhase::open);
     }
   }
-  /// Open: once the opening fingers clear a tall object (release_clearance), the retract; the
+  /// Open: once the opening fingers clear a tall object (release.clearance), the retract; the
   /// next move starts from there.
   void advance_open(const Tick& t) {
     const auto& g = t.world.gripper();
-    if (is_tall(plan_.object) && g.opening() && g.finger_width() < plan_.width + 2 * config_.release_clearance) return;
+    if (is_tall(plan_.object) && g.opening() && g.finger_width() < plan_.width + 2 * config_.release.clearance) return;
     // Up and away from the released object, also after the last move (fingers left
     // around it keep pushing it as the arm sways, and it never comes to rest).
     ++move_;
@@ -445,7 +447,7 @@ class Expert : private detail::GraspChoice {
     excluded_.clear();
     enter(ExpertPhase::retract);
     // a refused retract is not a failure: the next move plans from here, or the arm holds
-    if (!start_path(retract_pose(), false, config_.retract_peak_speed)) {
+    if (!start_path(retract_pose(), false, config_.retract.peak_speed)) {
       if (move_ < moves_) begin_move();
       else enter(ExpertPhase::idle);
     }
@@ -461,7 +463,7 @@ class Expert : private detail::GraspChoice {
   std::vector<ExpertEvent> events_;
   std::optional<std::string_view> failure_;
   bool touched_ = false;      ///< the lower phase found the object supported
-  bool lower_fast_ = false;   ///< the lower phase's first, fast line (slow_lower)
+  bool lower_fast_ = false;   ///< the lower phase's first, fast line (lower.slow_distance)
 };
 
 }  // namespace manisoft::task

@@ -2,17 +2,16 @@
 // "put object i at pose P" (the task type's move(): moves.hpp), as legs of straight lines.
 //
 // A move's waypoints (end-effector frame): approach (along the grasp annotation's approach
-// direction, approach_distance from the grasp), grasp, carry (above the place pose, diagonal from
-// the grasp), place. Each leg is direct or "via": the approach first level to above the
-// approach pose, for a tall object high enough that the fingertips pass approach_tip_clearance
-// above its top, and higher while the line there would still sweep them into it
-// (approach_clear()); the carry first straight up by lift_height, or until the object's bottom is
-// 2 x held_clearance above every other object and obstacle near its course (corridor_top()). The
-// high variants raise their via points by via_raise. A leg whose straight line would pass
-// towards the inner edge of the arm's reach (arc_inset nearer its base than its farther end)
-// goes round an arc point about the base instead (append_leg()). Into a container
-// (SupportKind::into) the object is lowered below the rim as far as the fingers allow
-// (sink_into_container()).
+// direction, approach.distance from the grasp), grasp, carry (above the place pose, diagonal from
+// the grasp), place. Each leg is direct or "via": the approach first level to above the approach
+// pose, for a tall object high enough that the fingertips pass approach.tip_clearance above its
+// top, and higher while the line there would still sweep them into it (approach_clear()); the carry
+// first straight up by carry.lift_height, or until the object's bottom is 2 x checks.held_clearance
+// above every other object and obstacle near its course (corridor_top()). The high variants raise
+// their via points by approach.via_raise. A leg whose straight line would pass towards the inner
+// edge of the arm's reach (paths.arc_inset nearer its base than its farther end) goes round an arc
+// point about the base instead (append_leg()). Into a container (SupportKind::into) the object is
+// lowered below the rim as far as the fingers allow (sink_into_container()).
 #pragma once
 
 #include <Eigen/Core>
@@ -51,7 +50,7 @@ class ExpertLegs {
 
   /// One move: the object, where it goes, and the end-effector waypoints. A leg is one or two
   /// straight lines: direct, or "via" (approach: level to above the approach pose first; carry:
-  /// straight up by lift_height first, then level to above the place pose).
+  /// straight up by carry.lift_height first, then level to above the place pose).
   /// The lines of a leg, in order; a "ramp" line is the executor's shape ramp to the pose's cold
   /// inverse statics solution instead of a straight line (the fallback of a refused line).
   struct Leg {
@@ -83,10 +82,10 @@ class ExpertLegs {
   }
   /// Height (world z) of object i's top as it stands now.
   double top_of(int object) const { return state_of(object).pose.act(Vec3(0, 0, scene::asset_height(asset_of(object)))).z(); }
-  /// Whether object i is tall: its height above tall_ratio x its width.
+  /// Whether object i is tall: its height above release.tall_ratio x its width.
   bool is_tall(int object) const {
     const auto& a = asset_of(object);
-    return scene::asset_height(a) > config_.tall_ratio * 2 * std::max(a.bounding_half_extents.x(), a.bounding_half_extents.y());
+    return scene::asset_height(a) > config_.release.tall_ratio * 2 * std::max(a.bounding_half_extents.x(), a.bounding_half_extents.y());
   }
   /// Whether the yaw of the object's target pose is free: the object is round, or the task
   /// states no orientation (states_yaw).
@@ -104,7 +103,7 @@ class ExpertLegs {
   /// Move k: which object goes where (read from the current state; the task type's move()).
   Move move_goal(int k) const {
     const Snapshot snapshot = env_->snapshot();
-    const MoveScene scene{env_->spec(), env_->library(), snapshot, config_.place_clearance};
+    const MoveScene scene{env_->spec(), env_->library(), snapshot, config_.lower.place_clearance};
     return visit_task(env_->spec().task, [&]<TaskType T>(T) { return T::move(k, scene); });
   }
   /// What move k puts its object into or onto (COLL: the container, STK: the item below; -1: the
@@ -114,15 +113,15 @@ class ExpertLegs {
     return visit_task(s.task, [&]<TaskType T>(T) { return T::support(k, s); });
   }
   /// Appends `to` to a leg, after an arc point when the straight line from `from` would pass
-  /// arc_inset closer to the arm's base (horizontally) than its farther end: the arm reaches an
-  /// annulus about its base, and a chord cuts towards its inner edge. The arc point: the farther
+  /// paths.arc_inset closer to the arm's base (horizontally) than its farther end: the arm reaches
+  /// an annulus about its base, and a chord cuts towards its inner edge. The arc point: the farther
   /// end's distance from the base at the ends' mean bearing, the higher end's height, the
   /// orientations' midway.
   void append_leg(Leg& leg, const Pose& from, const Pose& to) const {
     const Eigen::Vector2d base = env_->spec().arm_mount.base_position.head<2>();
     const Eigen::Vector2d a = from.translation.head<2>() - base, b = to.translation.head<2>() - base, ab = b - a;
     const double t = ab.squaredNorm() > 1e-12 ? std::clamp(-a.dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-    if ((a + t * ab).norm() < std::max(a.norm(), b.norm()) - config_.arc_inset) {
+    if ((a + t * ab).norm() < std::max(a.norm(), b.norm()) - config_.paths.arc_inset) {
       const double r = std::max(a.norm(), b.norm());
       const double bearing = std::atan2(a.y(), a.x()) + 0.5 * std::remainder(std::atan2(b.y(), b.x()) - std::atan2(a.y(), a.x()), 2 * std::numbers::pi);
       Pose via;
@@ -132,16 +131,16 @@ class ExpertLegs {
     }
     leg.push(to);
   }
-  /// The annotation's approach pose moved to approach_distance from its grasp (same direction).
+  /// The annotation's approach pose moved to approach.distance from its grasp (same direction).
   Pose approach_pose(const assets::GraspAnnotation& g) const {
     Pose a = g.approach;
     const Vec3 d = g.approach.translation - g.grasp.translation;
-    if (d.norm() > 1e-9) a.translation = g.grasp.translation + config_.approach_distance * d.normalized();
+    if (d.norm() > 1e-9) a.translation = g.grasp.translation + config_.approach.distance * d.normalized();
     return a;
   }
   /// The approach leg from the end-effector pose `from` (the annotation's approach pose last).
   /// "via": to above the approach pose first, then straight down; for a tall object (is_tall())
-  /// high enough that the fingertips pass approach_tip_clearance above its top, and raised by
+  /// high enough that the fingertips pass approach.tip_clearance above its top, and raised by
   /// another approach_raise_step (up to approach_raise_steps times) while the line there would
   /// still bring the open fingers into its reach (approach_clear(): a line that climbs from a
   /// lower start enters that reach before it is high enough). Returns approach_clear() of the leg.
@@ -151,7 +150,7 @@ class ExpertLegs {
     above.translation.z() = std::max(approach.translation.z(), from.translation.z()) + p.raise;
     const bool tall = p.via_approach && is_tall(p.object);
     if (tall)
-      above.translation.z() = std::max(above.translation.z(), approach.translation.z() + top_of(p.object) + config_.approach_tip_clearance - fingertips(approach).z());
+      above.translation.z() = std::max(above.translation.z(), approach.translation.z() + top_of(p.object) + config_.approach.tip_clearance - fingertips(approach).z());
     for (int raise = 0;; ++raise) {
       p.approach_leg.clear();
       Pose prev = from;
@@ -167,7 +166,7 @@ class ExpertLegs {
   }
   /// Whether the approach leg keeps the open fingers off a tall object (is_tall(); a low one
   /// does not tip over): sampled along each line (positions linear, the line's end orientation),
-  /// wherever the fingertips are lower than approach_tip_clearance above its top, the gripper's
+  /// wherever the fingertips are lower than approach.tip_clearance above its top, the gripper's
   /// axis is either over it (it is between the fingers whichever way they turn), out of the
   /// fingers' reach of it, or where it is at the approach pose (the straight descent onto the
   /// annotated grasp, which straddles the object as annotated, also when its footprint's
@@ -190,40 +189,40 @@ class ExpertLegs {
         x.translation = prev.translation + (double(k) / samples) * (to.translation - prev.translation);
         const Vec3 tips = fingertips(x);
         const double d = (tips.head<2>() - axis).norm();
-        if (tips.z() < top + config_.approach_tip_clearance && d > between && d < reach && (tips.head<2>() - last).norm() > straddle) return false;
+        if (tips.z() < top + config_.approach.tip_clearance && d > between && d < reach && (tips.head<2>() - last).norm() > straddle) return false;
       }
       prev = to;
     }
     return true;
   }
-  /// Into a container (SupportKind::into: COLL): the object is released low in the container
-  /// (its bottom place_clearance above the floor) rather than dropped from above the rim (a tall
-  /// one dropped inner_depth rocks on in the container for seconds), as far as the fingertips
-  /// stay finger_clearance above the rim, or down to the floor when the open gripper fits into
-  /// the opening (a basket). move_goal() puts the object's bottom place_clearance above the rim;
-  /// this lowers it.
+  /// Into a container (SupportKind::into: COLL): the object is released low in the container (its
+  /// bottom lower.place_clearance above the floor) rather than dropped from above the rim (a tall
+  /// one dropped inner_depth rocks on in the container for seconds), as far as the fingertips stay
+  /// retract.finger_clearance above the rim, or down to the floor when the open gripper fits into
+  /// the opening (a basket). move_goal() puts the object's bottom lower.place_clearance above the
+  /// rim; this lowers it.
   void sink_into_container(Plan& p, const Support& support) const {
     if (support.kind != SupportKind::into) return;
     const auto& rc = asset_of(support.object).receptacles.at(0);
-    // A container whose opening the open gripper fits into (finger_clearance to spare, at any
-    // yaw): the object goes down to its floor.
+    // A container whose opening the open gripper fits into (retract.finger_clearance to spare, at
+    // any yaw): the object goes down to its floor.
     const double reach = std::hypot(gripper_half_.x(), gripper_half_.y());
     const double room = rc.inner_radius > 0 ? rc.inner_radius : rc.inner_half_extents.minCoeff();
     const double rim = (state_of(support.object).pose * rc.opening).translation.z();
-    p.sink = room >= reach + config_.finger_clearance ? rc.inner_depth
-                                                        : std::clamp(fingertips(p.place).z() - (rim + config_.finger_clearance), 0.0, rc.inner_depth);
+    p.sink = room >= reach + config_.retract.finger_clearance ? rc.inner_depth
+                                                                : std::clamp(fingertips(p.place).z() - (rim + config_.retract.finger_clearance), 0.0, rc.inner_depth);
     p.place.translation.z() -= p.sink;
     p.object_target.translation.z() -= p.sink;
   }
-  /// The carry leg from the grasp to carry_height (plus the sink) above the place pose.
+  /// The carry leg from the grasp to carry.height (plus the sink) above the place pose.
   void set_carry_leg(Plan& p) const {
     Pose above = p.place;
-    above.translation.z() += config_.carry_height + p.sink;
+    above.translation.z() += config_.carry.height + p.sink;
     p.carry_leg.clear();
     Pose prev = p.grasp;
     if (p.via_carry) {
       Pose lift = p.grasp;
-      lift.translation.z() += std::max(config_.lift_height, corridor_top(p) + 2 * config_.held_clearance - state_of(p.object).pose.translation.z()) + p.raise;
+      lift.translation.z() += std::max(config_.carry.lift_height, corridor_top(p) + 2 * config_.checks.held_clearance - state_of(p.object).pose.translation.z()) + p.raise;
       above.translation.z() = std::max(above.translation.z(), lift.translation.z());
       append_leg(p.carry_leg, prev, lift);
       prev = lift;
@@ -233,11 +232,11 @@ class ExpertLegs {
   /// The highest top (world z) of the other objects and obstacles near the carry's course from
   /// the grasp to the place (the straight line or, at the edge of the reach, its arc point:
   /// append_leg), horizontally within their footprint radius plus the moved object's plus
-  /// held_clearance; the table top when there are none.
+  /// checks.held_clearance; the table top when there are none.
   double corridor_top(const Plan& p) const {
     Leg course;
     append_leg(course, p.grasp, p.place);
-    const double r = scene::footprint_radius(asset_of(p.object)) + config_.held_clearance;
+    const double r = scene::footprint_radius(asset_of(p.object)) + config_.checks.held_clearance;
     auto near = [&](const Pose& pose, const assets::Asset& asset) {
       const Eigen::Vector2d c = pose.act(asset.bounding_center).head<2>();
       Eigen::Vector2d a = p.grasp.translation.head<2>();

@@ -1,13 +1,13 @@
-// The expert's choice of grasp for a move (paper section 3.4). The candidates: each of the
-// asset's annotated grasps, also turned half a turn about the fingers' axis (the parallel
-// gripper is symmetric) and about the object's axis as its symmetry allows (round: eighth turns,
-// square: quarter turns), each with seven leg variants (the approach and the carry each direct or
-// "via", and the via ones again raised by via_raise: expert_legs.hpp). Their cost: least turning
-// from the home pose (the grasp's and the place's end-effector poses) first, then the fewest
-// lines; approaches that would sweep the open fingers into a tall object last. The chosen one is
-// the cheapest whose whole sequence passes the checks (expert_checks.hpp): first with straight
-// lines only, then (not on a re-try) with refused lines repaired by shape ramps. No detour around
-// an obstacle is planned: a move with no clear candidate is given up. Grasps a re-try left out
+// The expert's choice of grasp for a move (paper section 3.4). The candidates: each of the asset's
+// annotated grasps, also turned half a turn about the fingers' axis (the parallel gripper is
+// symmetric) and about the object's axis as its symmetry allows (round: eighth turns, square:
+// quarter turns), each with seven leg variants (the approach and the carry each direct or "via",
+// and the via ones again raised by approach.via_raise: expert_legs.hpp). Their cost: least turning
+// from the home pose (the grasp's and the place's end-effector poses) first, then the fewest lines;
+// approaches that would sweep the open fingers into a tall object last. The chosen one is the
+// cheapest whose whole sequence passes the checks (expert_checks.hpp): first with straight lines
+// only, then (not on a re-try) with refused lines repaired by shape ramps. No detour around an
+// obstacle is planned: a move with no clear candidate is given up. Grasps a re-try left out
 // (excluded_) are not candidates.
 #pragma once
 
@@ -64,7 +64,7 @@ class GraspChoice : protected ExpertChecks {
             sink_into_container(p, support);
             p.via_approach = variant & 1;
             p.via_carry = variant & 2;
-            p.raise = variant & 4 ? config_.via_raise : 0.0;
+            p.raise = variant & 4 ? config_.approach.via_raise : 0.0;
             const bool clear = set_approach_leg(p, now * about_axis * approach_pose(g) * half, from);
             set_carry_leg(p);
             // least turning first, then the fewest lines
@@ -79,23 +79,23 @@ class GraspChoice : protected ExpertChecks {
     return candidates;
   }
   /// Checks candidate plan p of move k on planner_ from `executor`'s shape target: approach,
-  /// grasp, carry (holding the object), place. False (the first refusal noted in plan_refusal_)
-  /// when a line is refused.
-  bool check_candidate(Plan& p, int k, const Executor& executor) {
+  /// grasp, carry (holding the object), place; `plan`: the moved object and whether refused lines
+  /// may be repaired. False (the first refusal noted in plan_refusal_) when a line is refused.
+  bool check_candidate(Plan& p, int k, const Executor& executor, const LinePlan& plan) {
     const auto& a = asset_of(p.object);
     const Pose now = state_of(p.object).pose;
     planner_ = executor;
     planner_.complete_path();
     const char* why = "";
     const char* where = "";
-    bool ok = check_leg(p.approach_leg, why);
+    bool ok = check_leg(p.approach_leg, plan, why);
     if (!ok) where = "approach";
-    if (ok && !(ok = check_line(p.grasp, why))) where = "grasp";
+    if (ok && !(ok = check_line(p.grasp, plan, why))) where = "grasp";
     if (ok) {
       planner_.set_payload(a.mass, p.grasp.rotation.transpose() * (now.act(a.center_of_mass) - p.grasp.translation));
-      if (!(ok = check_carry_leg(p, p.grasp, now, support_of(k).object, why))) where = "carry";
+      if (!(ok = check_carry_leg(p, p.grasp, now, support_of(k).object, plan, why))) where = "carry";
     }
-    if (ok && !(ok = check_line(p.place, why))) where = "place";
+    if (ok && !(ok = check_line(p.place, plan, why))) where = "place";
     if (!ok && plan_refusal_.empty()) plan_refusal_ = std::string(where) + ": " + why;
     return ok;
   }
