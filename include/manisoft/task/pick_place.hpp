@@ -68,7 +68,7 @@ inline std::vector<assets::Asset> pick_place_catalog(PickPlaceObject o, double m
 /// the tip overshoots the planned speed by up to about 60%.
 inline ExpertConfig pick_place_expert_config() {
   ExpertConfig c;
-  c.path_peak_speed = c.max_node_speed = c.carry_peak_speed = c.carry_node_speed = 0.9;
+  c.paths.peak_speed = c.paths.node_speed = c.carry.peak_speed = c.carry.node_speed = 0.9;
   return c;
 }
 /// The task environment's configuration for the pick and place: the expert's shape ramps (its
