@@ -16,7 +16,8 @@ using manisoft::scene::SceneValidator;
 TEST_CASE("pick and place: the object rests on the table as drawn and its mass can be set", "[tasks][pick_place]") {
   const AssetLibrary library(task::pick_place_catalog(task::PickPlaceObject::cube, 0.3));
   const auto& cube = library.get(task::pick_place_asset(task::PickPlaceObject::cube), "test");
-  const auto& catalogue = AssetLibrary{}.get(cube.id, "test");
+  const AssetLibrary catalogue_library;
+  const auto& catalogue = catalogue_library.get(cube.id, "test");
   CHECK(cube.mass == 0.3);
   CHECK((cube.inertia - catalogue.inertia * (0.3 / catalogue.mass)).norm() < 1e-15);
   CHECK_THROWS_WITH(task::pick_place_catalog(task::PickPlaceObject::cube, -1), Catch::Contains("-1"));
