@@ -107,7 +107,7 @@ class Worker {
       // drives is not kept, so its remaining steps until the horizon would be spent for nothing.
       while (!env_.done() && !expert_.failure()) {
         expert_.act(torques, s);
-        recorder.step(torques, s);
+        recorder.step(torques, s, expert_.target());
         env_.step(torques, s);
       }
       if (env_.info().success) {

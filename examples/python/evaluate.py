@@ -16,6 +16,11 @@ Policies (--policy):
                          uint8, "prompt": str} with {"actions": H x (3n+1)} (numpy arrays in openpi's
                          msgpack encoding)
 A chunk's first --chunk-steps actions are executed before the policy is asked again.
+--action-mode ee_pose evaluates on the end-effector track instead of the paper's torque track: an
+action is 7 floats (target position, rotation vector, S; manisoft.make_env(..., action_mode=
+"ee_pose")) tracked by the model executor for --action-repeat control steps (default 36: 20 Hz);
+the expert then sends the targets it tracked at each control step of its own episode on the torque
+track (run first), every --action-repeat steps.
 
 Scenes: the evaluation split (never drawn by dataset generation), eval indices 0, 1, 2, ... of each
 task and setting, the first K of each target-object category (STK: K in all); horizon T = manisoft.HORIZON (1500).
@@ -257,6 +262,38 @@ class ReplayPolicy:
         return self.actions[self.step - 1]
 
 
+class ExpertTargetsPolicy:
+    """The expert on the end-effector track: its episode is first run on the torque track (where
+    it acts at the control rate), its end-effector target and S recorded at every control step;
+    the action at control step k is the target recorded there (every action_repeat steps)."""
+
+    def __init__(self, args):
+        self.args, self.envs, self.targets, self.step = args, {}, None, 0
+
+    def start(self, task, setting, index):
+        key = (task, setting)
+        if key not in self.envs:
+            self.envs[key] = manisoft.make_env(task, setting, seed=self.args.seed, split="eval", render=False)
+        env = self.envs[key]
+        env.reset(seed=self.args.seed, options={"index": index, "split": "eval"})
+        self.targets, self.step = [], 0
+        while True:
+            action = env.expert_action()
+            self.targets.append(env.expert_target())
+            *_, terminated, truncated, _ = env.step(action)
+            if terminated or truncated:
+                break
+
+    def __call__(self, obs):
+        target = self.targets[min(self.step, len(self.targets) - 1)]
+        self.step += self.args.action_repeat
+        return target
+
+    def close(self):
+        for env in self.envs.values():
+            env.close()
+
+
 def load_python_policy(spec, extra_path):
     _, module_name, function_name = spec.split(":", 2)
     for p in [os.getcwd()] + list(extra_path):
@@ -311,12 +348,15 @@ class Worker:
             width, height = self.args.image_size
             needs_image = not (self.args.policy in ("expert", "random") or self.args.policy.startswith("replay:"))
             self.envs[key] = manisoft.make_env(task, setting, seed=self.args.seed, split="eval", render=needs_image,
-                                               camera={"width": width, "height": height})
+                                               camera={"width": width, "height": height}, action_mode=self.args.action_mode,
+                                               action_repeat=self.args.action_repeat)
         return self.envs[key]
 
     def make_policy(self, env):
         spec = self.args.policy
         if spec == "expert":
+            if self.args.action_mode == "ee_pose":
+                return ExpertTargetsPolicy(self.args)
             return lambda obs: self.current.expert_action()
         if spec == "random":
             return RandomPolicy(env.action_space, self.args.seed)
@@ -378,6 +418,8 @@ class Worker:
     def close(self):
         if isinstance(self.policy, WebsocketPolicy):
             self.policy.close(final=True)
+        if isinstance(self.policy, ExpertTargetsPolicy):
+            self.policy.close()
         for env in self.envs.values():
             env.close()
 
@@ -424,7 +466,8 @@ def write_outputs(out, args, episodes, wall):
     write_csv(os.path.join(out, "episodes.csv"), fields, episodes)
     rows = table_rows(episodes)
     write_csv(os.path.join(out, "results.csv"), list(rows[0].keys()) if rows else [], rows)
-    lines = [f"# ManiSoft evaluation: policy `{args.policy}`", "",
+    track = "torque" if args.action_mode == "torque" else f"ee_pose, {args.action_repeat} control steps an action"
+    lines = [f"# ManiSoft evaluation: policy `{args.policy}`, action mode {track}", "",
              f"Held-out (eval) scenes, seed {args.seed}, " + (f"eval indices {args.indices}" if args.indices else
              f"up to {args.episodes_per_category or '20 (clean) / 40 (randomized)'} episodes per target category") + ", "
              f"horizon {HORIZON}; {len(episodes)} episodes in {wall:.0f} s. ACC: success % with its 95% Wilson interval; "
@@ -447,7 +490,7 @@ def write_outputs(out, args, episodes, wall):
     for (task, setting, reason), n in sorted(Counter((e["task"], e["setting"], e["failure"]) for e in episodes if not e["success"]).items()):
         lines.append(f"| {task} | {setting} | {reason} | {n} |")
     write_text(os.path.join(out, "results.md"), "\n".join(lines) + "\n")
-    summary = {"policy": args.policy, "seed": args.seed, "episodes": len(episodes), "wall_s": round(wall, 1),
+    summary = {"policy": args.policy, "action_mode": args.action_mode, "action_repeat": args.action_repeat, "seed": args.seed, "episodes": len(episodes), "wall_s": round(wall, 1),
                "success_rate": sum(e["success"] for e in episodes) / max(1, len(episodes)),
                "tables": [{k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in r.items()} for r in rows if r["category"] == "all"]}
     write_text(os.path.join(out, "summary.json"), json.dumps(summary, indent=2, allow_nan=False) + "\n")
@@ -482,6 +525,10 @@ def parse_args(argv):
     p.add_argument("--out", required=True)
     p.add_argument("--jobs", type=int, default=1, help="worker processes")
     p.add_argument("--chunk-steps", type=int, default=1, help="actions of a chunk executed before asking the policy again")
+    p.add_argument("--action-mode", default="torque", choices=("torque", "ee_pose"),
+                   help="torque: the paper's 3n + 1 torques and S a control step; ee_pose: an end-effector target "
+                        "(position, rotation vector) and S tracked by the model executor for --action-repeat control steps")
+    p.add_argument("--action-repeat", type=int, default=36, help="control steps an ee_pose action is tracked (36: 20 Hz)")
     p.add_argument("--policy-timeout", type=float, default=60.0, help="seconds a policy call may take")
     p.add_argument("--image-size", type=int, nargs=2, default=[514, 514], metavar=("W", "H"))
     p.add_argument("--save-actions", action="store_true", help="write each episode's actions to OUT/actions/ (for replay:OUT)")
@@ -494,7 +541,7 @@ def parse_args(argv):
         check_spec(args.policy)
     except ValueError as e:
         p.error(str(e))
-    for name in ("jobs", "chunk_steps"):
+    for name in ("jobs", "chunk_steps", "action_repeat"):
         if getattr(args, name) < 1:
             p.error(f"--{name.replace('_', '-')} must be >= 1")
     if args.episodes_per_category is not None and args.episodes_per_category < 1:
@@ -532,7 +579,7 @@ def parse_args(argv):
 # ---- the run's progress: run.json (its arguments) and episodes.jsonl (each finished episode)
 
 RUN_ARGUMENTS = ("policy", "seed", "tasks", "settings", "episodes_per_category", "indices", "max_scan", "chunk_steps",
-                 "policy_timeout", "image_size")
+                 "policy_timeout", "image_size", "action_mode", "action_repeat")
 
 
 def run_arguments(args):

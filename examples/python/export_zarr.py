@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """export_zarr DIR OUT.zarr [--split train|valid|all]: a ManiSoft dataset (robomimic-layout HDF5)
 as Diffusion Policy's zarr replay buffer (Debian python3-zarr): data/action (N x 61),
-data/state, data/eef_pose, data/gripper, data/rod_centerline (N x 63), data/rod_directors (N x 180) and data/img (N x H x W x 3
+data/state, data/eef_pose, data/gripper, data/rod_centerline (N x 63), data/rod_directors (N x 180), data/ee_target (N x 7: the
+end-effector track's action), data/ee_waypoint (N x 1) and data/img (N x H x W x 3
 uint8, when the episodes carry an image at every step) concatenated over the episodes of the
 split, and meta/episode_ends (int64, cumulative step counts), Diffusion Policy's ReplayBuffer
 layout. Episodes with different object counts cannot share object_poses/state widths: state
@@ -29,7 +30,7 @@ def main():
             names = [m.decode() for m in f["mask"][args.split][()]]
         demos = [f["data"][n] for n in names]
         fixed = {"action": "actions", "eef_pose": "obs/eef_pose", "gripper": "obs/gripper", "rod_centerline": "obs/rod_centerline",
-                 "rod_directors": "obs/rod_directors"}
+                 "rod_directors": "obs/rod_directors", "ee_target": "obs/ee_target", "ee_waypoint": "obs/ee_waypoint"}
         padded = {"state": "states", "object_poses": "obs/object_poses"}
         arrays = {k: np.concatenate([d[v][()] for d in demos]) for k, v in fixed.items()}
         for k, v in padded.items():

@@ -444,6 +444,10 @@ PYBIND11_MODULE(_manisoft, m) {
       .def("step", &TaskEnvironment::step, py::arg("action"),
            "One control step (7 x 0.2 ms): (observation, reward, terminated, truncated, info)")
       .def("expert_action", &TaskEnvironment::expert_action, "The rule-based expert's action now (privileged: it reads the world)")
+      .def("expert_target", &TaskEnvironment::expert_target,
+           "The expert's end-effector target and gripper state after expert_action(), as an 'ee_pose' action (7 floats)")
+      .def_property_readonly("action_mode", &TaskEnvironment::action_mode)
+      .def_property_readonly("action_repeat", &TaskEnvironment::action_repeat, "control steps a step() takes (1 on the torque track)")
       .def("render", &TaskEnvironment::render, "The current camera image (uint8 H x W x 3)")
       .def("close", &TaskEnvironment::close)
       .def("scene_json", &TaskEnvironment::scene_json, "The episode's scene (manisoft.scene/1 JSON)")
@@ -455,8 +459,12 @@ PYBIND11_MODULE(_manisoft, m) {
   m.def(
       "make_env",
       [](const std::string& name, const std::string& setting, std::uint64_t seed, bool render, const std::optional<py::dict>& camera,
-         bool privileged, const std::string& split, const std::string& target_set, int horizon) -> py::object {
-        if (name == "reach") return py::cast(std::make_unique<ReachEnvironment>(target_set, seed, horizon));
+         bool privileged, const std::string& split, const std::string& target_set, int horizon, const std::string& action_mode,
+         int action_repeat) -> py::object {
+        if (name == "reach") {
+          if (action_mode != "torque") throw py::value_error("make_env: the reach environment's actions are torques (action_mode 'torque')");
+          return py::cast(std::make_unique<ReachEnvironment>(target_set, seed, horizon));
+        }
         std::string names;
         bool known = false;
         for (const auto t : manisoft::scene::all_tasks) {
@@ -466,11 +474,13 @@ PYBIND11_MODULE(_manisoft, m) {
         if (!known) throw py::value_error("make_env: unknown environment '" + name + "' (available: " + names + "reach)");
         if (horizon != task_horizon)
           throw py::value_error("make_env: the tasks' horizon is the paper's T = " + std::to_string(task_horizon) + " (got " + std::to_string(horizon) + ")");
-        return py::cast(std::make_unique<TaskEnvironment>(name, setting, seed, render, camera, privileged, split));
+        return py::cast(std::make_unique<TaskEnvironment>(name, setting, seed, render, camera, privileged, split, action_mode, action_repeat));
       },
       py::arg("name"), py::arg("setting") = "clean", py::arg("seed") = 0, py::arg("render") = true, py::arg("camera") = py::none(),
       py::arg("privileged") = false, py::arg("split") = "train", py::arg("target_set") = "table", py::arg("horizon") = task_horizon,
-      "Makes an environment: make_env(task, 'clean'|'randomized', seed=0, render=True, camera=None, privileged=False, split='train') "
+      py::arg("action_mode") = "torque", py::arg("action_repeat") = manisoft::task::EeTrackConfig{}.action_repeat,
+      "Makes an environment: make_env(task, 'clean'|'randomized', seed=0, render=True, camera=None, privileged=False, split='train', "
+      "action_mode='torque'|'ee_pose', action_repeat=36) "
       "(the paper's observation: image and instruction; privileged=True adds the state, render=False leaves the image out) "
       "for a task of manisoft.tasks(), or make_env('reach', target_set='table'|'equilibria', seed=0, horizon=HORIZON)");
   // The tasks and the episode's timing, from the one definition of each (task/registry.hpp, TaskEnvConfig).

@@ -4,10 +4,14 @@
 // OpenGL renderer) over scene::make_render_scene, and the rule-based expert (task::Expert) for
 // collecting data or as an upper bound. Gymnasium's signatures, no gymnasium dependency.
 //
-// Action (the paper's, section 3.2): one float vector of 3n + 1 entries, the n x 3 material-frame
-// element torques flattened row by row (element 0 is the clamped base: its bounds are 0), then the
-// gripper state S (>= 0.5 closed, below open). Torques are clamped to the actuation limits; NaN,
-// wrong shape or a non-real dtype raise ValueError and change nothing.
+// Action, action_mode "torque" (the paper's, section 3.2): one float vector of 3n + 1 entries, the
+// n x 3 material-frame element torques flattened row by row (element 0 is the clamped base: its
+// bounds are 0), then the gripper state S (>= 0.5 closed, below open); one control step a call.
+// Torques are clamped to the actuation limits. action_mode "ee_pose" (task/ee_track.hpp): 7 floats,
+// the end effector's target position (m, world) and orientation as a rotation vector r (rad, world
+// frame) from the home (tool-down) orientation, R = exp([r]x) R_home (task::ee_action), then S; the model executor tracks the target for
+// action_repeat control steps a call (default 36: 20 Hz). NaN, wrong shape or a non-real dtype
+// raise ValueError and change nothing.
 // Observation: "instruction" (str) and, when rendering, "image" (uint8 H x W x 3, a fresh array a
 // step, handed over without a copy); with privileged=True also "end_effector" (4 x 4, the rod tip's
 // frame), "gripper_pose" (4 x 4, the gripper body: what Renderer.render takes), "rod_nodes" ((n+1) x 3), "gripper_width" (m), "gripper_state" (S), "object_poses"
@@ -23,6 +27,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <thread>
@@ -34,6 +39,7 @@
 #include "manisoft/scene/scene_json.hpp"
 #include "manisoft/scene/scene_render.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
+#include "manisoft/task/ee_track.hpp"
 #include "manisoft/task/expert.hpp"
 #include "manisoft/task/task_env.hpp"
 
@@ -227,14 +233,52 @@ inline py::dict task_action_spec(int n) {
   return d;
 }
 
+/// The end-effector track's action space: target position within a box around the arm's reach
+/// (its base +- its length), rotation vector within [-pi, pi] each, then S in [0, 1].
+inline py::dict ee_action_spec() {
+  const ms::world::ArmMount mount{};
+  const double reach = ms::world::tabletop_arm_parameters().length;
+  py::array_t<double> low(7), high(7);
+  auto l = low.mutable_unchecked<1>();
+  auto h = high.mutable_unchecked<1>();
+  for (int c = 0; c < 3; ++c) {
+    l(c) = mount.base_position(c) - reach;
+    h(c) = mount.base_position(c) + reach;
+    l(3 + c) = -std::numbers::pi;
+    h(3 + c) = std::numbers::pi;
+  }
+  l(6) = 0.0;
+  h(6) = 1.0;
+  py::dict d;
+  d["shape"] = py::make_tuple(7);
+  d["dtype"] = "float64";
+  d["low"] = low;
+  d["high"] = high;
+  d["layout"] = "end-effector target position x y z (m, world), rotation vector rx ry rz from the home (tool-down) orientation "
+                "(rad, world frame: R = exp([r]x) R_home), then S (>= 0.5 closed)";
+  return d;
+}
+
+/// An end-effector action of a pose and S (task::ee_action).
+inline py::array_t<double> ee_action_of(const ms::task::TaskEnv& env, const ms::math::Pose<double>& p, int s) {
+  py::array_t<double> out(7);
+  auto v = out.mutable_unchecked<1>();
+  const auto a = ms::task::ee_action(p, s, env.home_pose().rotation);
+  for (int c = 0; c < 7; ++c) v(c) = a(c);
+  return out;
+}
+
 class TaskEnvironment {
  public:
   using Array3 = ms::task::TaskEnv::Array3;
   using Action = ms::control::FlatAction;
 
   TaskEnvironment(const std::string& task, const std::string& setting, std::uint64_t seed, bool render, const std::optional<py::dict>& camera,
-                  bool privileged, const std::string& split)
-      : env_(sampler_.library()), expert_(env_), seed_(seed), render_(render), privileged_(privileged) {
+                  bool privileged, const std::string& split, const std::string& action_mode, int action_repeat)
+      : env_(sampler_.library()), expert_(env_), track_(env_, track_config(action_repeat)), seed_(seed), render_(render), privileged_(privileged) {
+    if (action_mode != "torque" && action_mode != "ee_pose")
+      throw py::value_error("make_env: action_mode = '" + action_mode + "' must be 'torque' or 'ee_pose'");
+    ee_mode_ = action_mode == "ee_pose";
     request_.task = ms::scene::parse_task(task);
     request_.setting = ms::scene::parse_setting(setting);
     request_.split = ms::scene::parse_split(split);
@@ -283,7 +327,9 @@ class TaskEnvironment {
       }
       env_.reset(spec_);
       expert_.reset();
+      track_.reset();
     }
+    expert_s_ = 0;
     seed_ = q.seed;
     next_index_ = q.index + 1;
     const auto& list = instruction_kind == "seen" ? spec_.instructions_seen : instruction_kind == "unseen" ? spec_.instructions_unseen : std::vector<std::string>{};
@@ -302,6 +348,7 @@ class TaskEnvironment {
     const auto entered = threads_.enter("step");
     check_started();
     if (env_.done()) throw std::runtime_error("step: the episode is over (" + std::to_string(env_.info().step) + " steps); call reset()");
+    if (ee_mode_) return step_end_effector(action);
     int s = read_action(action, torques_);
     {
       py::gil_scoped_release release;
@@ -311,15 +358,29 @@ class TaskEnvironment {
     return py::make_tuple(observation(), i.success ? 1.0 : 0.0, i.terminated, i.truncated, info());
   }
 
+  /// The expert's end-effector target and gripper state after expert_action() (the end of the
+  /// line or ramp it tracks), as an "ee_pose" action: recorded on the torque track, the targets
+  /// drive the end-effector track (privileged).
+  py::array_t<double> expert_target() {
+    const auto entered = threads_.enter("expert_target");
+    check_started();
+    if (ee_mode_)
+      throw std::runtime_error("expert_target: the expert acts at the control rate on the torque track; record its targets there "
+                               "(make_env(..., action_mode='torque'): expert_action(), then expert_target())");
+    return ee_action_of(env_, expert_.target(), expert_s_);
+  }
+
   /// The expert's action for the current state (privileged: it reads the world).
   py::array_t<double> expert_action() {
     const auto entered = threads_.enter("expert_action");
     check_started();
+    if (ee_mode_) throw std::runtime_error("expert_action: the expert's actions are torques (make_env(..., action_mode='torque'))");
     int s = 0;
     {
       py::gil_scoped_release release;
       expert_.act(torques_, s);
     }
+    expert_s_ = s;
     py::array_t<double> out(Action::size(n_));
     Action::pack(torques_, s, out.mutable_unchecked<1>());
     return out;
@@ -334,7 +395,9 @@ class TaskEnvironment {
     return renderer_->render();
   }
 
-  py::dict action_space() const { return task_action_spec(n_); }
+  py::dict action_space() const { return ee_mode_ ? ee_action_spec() : task_action_spec(n_); }
+  std::string action_mode() const { return ee_mode_ ? "ee_pose" : "torque"; }
+  int action_repeat() const { return ee_mode_ ? track_.config().action_repeat : 1; }
 
   py::dict observation_space() const {
     py::dict d;
@@ -393,6 +456,49 @@ class TaskEnvironment {
       if (!std::isfinite(v(i)))
         throw py::value_error("step: action entry " + std::to_string(i) + " (" + Action::describe(static_cast<int>(i), n_) + ") is not finite");
     return Action::unpack(v, torques);
+  }
+
+  static ms::task::EeTrackConfig track_config(int action_repeat) {
+    ms::task::EeTrackConfig c;
+    if (action_repeat < 1) throw py::value_error("make_env: action_repeat = " + std::to_string(action_repeat) + " must be at least 1");
+    c.action_repeat = action_repeat;
+    return c;
+  }
+
+  /// One "ee_pose" action: the target commanded, then action_repeat control steps (fewer when the
+  /// episode ends). The reward is 1 when the task succeeds within them.
+  py::tuple step_end_effector(const py::handle& given) {
+    const py::array action = action_array(given, "step: action");
+    const char kind = action.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u')
+      throw py::value_error("step: action dtype must be real (float64 preferred), got " + std::string(py::str(action.dtype())));
+    if (action.ndim() != 1 || action.shape(0) != 7)
+      throw py::value_error("step: an ee_pose action must have shape (7,) (position, rotation vector, S), got " +
+                            std::string(py::str(py::handle(action).attr("shape"))));
+    const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(action);
+    const auto v = values.unchecked<1>();
+    static constexpr const char* names[7] = {"x", "y", "z", "rx", "ry", "rz", "S"};
+    for (py::ssize_t i = 0; i < 7; ++i)
+      if (!std::isfinite(v(i))) throw py::value_error("step: action entry " + std::to_string(i) + " (" + names[i] + ") is not finite");
+    ms::task::EeAction a;
+    for (int c = 0; c < 7; ++c) a(c) = v(c);
+    const ms::math::Pose<double> target = ms::task::ee_target_of(a, env_.home_pose().rotation);
+    const int s = v(6) >= 0.5 ? 1 : 0;
+    ms::task::EeCommand command{};
+    int taken = 0;
+    {
+      py::gil_scoped_release release;
+      command = track_.command(target);
+      for (; taken < track_.config().action_repeat && !env_.done(); ++taken) {
+        track_.act(torques_);
+        env_.step(torques_, s);
+      }
+    }
+    const auto& i = env_.info();
+    py::dict d = info();
+    d["ee_command"] = std::string(ms::task::to_string(command));
+    d["control_steps"] = taken;
+    return py::make_tuple(observation(), i.success ? 1.0 : 0.0, i.terminated, i.truncated, d);
   }
 
   std::vector<ms::math::Pose<double>> object_poses() const {
@@ -468,6 +574,9 @@ class TaskEnvironment {
   ms::scene::SceneSampler sampler_;
   ms::task::TaskEnv env_;
   ms::task::Expert expert_;
+  ms::task::EndEffectorTrack track_;
+  bool ee_mode_ = false;
+  int expert_s_ = 0;  ///< the expert's S after its last expert_action()
   ms::scene::SampleRequest request_;
   std::uint64_t seed_;
   std::uint64_t next_index_ = 0;

@@ -109,5 +109,9 @@ assert np.array_equal(z["meta/episode_ends"][:], ends), "episode_ends"
 assert np.array_equal(z["data/action"][:], actions), "actions"
 assert z["data/rod_centerline"].shape == (ends[-1], 63), z["data/rod_centerline"].shape
 assert z["data/rod_directors"].shape == (ends[-1], 180), z["data/rod_directors"].shape
+targets = np.concatenate([d["obs/ee_target"][()] for d in demos])
+assert np.array_equal(z["data/ee_target"][:], targets), "ee_target"
+assert np.array_equal(targets[:, 6], actions[:, -1]), "the ee target's S is the action's"
+assert z["data/ee_waypoint"].shape == (ends[-1], 1), z["data/ee_waypoint"].shape
 PY
 echo "generate_dataset: 1 shard == 3 shards == killed + resumed; verify, h5py read (all four tasks), stats and zarr export OK"

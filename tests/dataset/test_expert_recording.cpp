@@ -1,7 +1,9 @@
 // Recording a task episode (include/manisoft/dataset/expert_recording.hpp) and replaying it: the
 // stored states match a replay from the scene JSON and the actions bit for bit, also after a
 // round trip through the episode file; a changed action is caught at the next step; the first
-// state is the scene as sampled (rod clamped at the mount, objects where the scene put them).
+// state is the scene as sampled (rod clamped at the mount, objects where the scene put them); the
+// recorded end-effector targets, read back from the file (float32) and sent at 20 Hz, drive the
+// end-effector track to the expert's outcome.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
@@ -9,6 +11,7 @@
 #include "manisoft/dataset/episode_file.hpp"
 #include "manisoft/dataset/expert_recording.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
+#include "manisoft/task/ee_track.hpp"
 #include "manisoft/task/expert.hpp"
 #include "../support/scratch_dir.hpp"
 
@@ -29,7 +32,7 @@ TEST_CASE("a recorded expert episode replays bit for bit, from memory and from i
   int s = 0;
   while (!env.done()) {
     expert.act(torques, s);
-    recorder.step(torques, s);
+    recorder.step(torques, s, expert.target());
     env.step(torques, s);
   }
   const dataset::Episode e = recorder.finish(3, 0, 0);
@@ -72,4 +75,31 @@ TEST_CASE("a recorded expert episode replays bit for bit, from memory and from i
   dataset::Episode changed = back;
   changed.actions(100, 3 * 5) += 1.0;  // element 5, d1: 1 N m more at step 100
   CHECK(dataset::replay_mismatch(env, changed) == 101);
+
+  // obs/ee_target: the expert's target at each step (its S the action's), obs/ee_waypoint counts
+  // its changes; sent to the end-effector track every action_repeat steps they reach the same outcome
+  const auto& target = back.observations.at("ee_target");
+  const auto& waypoint = back.observations.at("ee_waypoint");
+  REQUIRE(target.cols() == 7);
+  CHECK(waypoint(0, 0) == 0.0);
+  int changes = 0;
+  for (long r = 0; r < back.steps(); ++r) {
+    CHECK(target(r, 6) == back.actions(r, 3 * n));
+    if (r > 0 && target.row(r).head(6) != target.row(r - 1).head(6)) ++changes;  // the pose, not S
+  }
+  CHECK(waypoint(back.steps() - 1, 0) == changes);
+  CHECK(changes >= 4);
+  task::EndEffectorTrack track(env);
+  env.reset(spec);
+  track.reset();
+  const int repeat = track.config().action_repeat;
+  for (long k = 0; !env.done();) {
+    const task::EeAction a = target.row(std::min(k, back.steps() - 1)).transpose();
+    track.command(task::ee_target_of(a, env.home_pose().rotation));
+    for (int r = 0; r < repeat && !env.done(); ++r, ++k) {
+      track.act(torques);
+      env.step(torques, static_cast<int>(a(6)));
+    }
+  }
+  CHECK(env.info().success == (e.rewards.sum() == 1.0));
 }

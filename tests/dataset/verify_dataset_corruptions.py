@@ -167,7 +167,10 @@ for name, dataset, element, value, expected in [
         ("action_infinite", "actions", (4, 5), -np.inf, "actions[4, 5] = -inf is not finite"),
         ("reward_5", "rewards", 2, 5, "/data/demo_0/rewards: element [2] = 5: rewards are 0"),
         ("last_done_0", "dones", T - 1, 0, f"/data/demo_0/dones: element [{T - 1}] = 0: dones must be 0 before the last step and 1 at it"),
-        ("object_pose_nan", "obs/object_poses", (7, 3), np.nan, "obs/object_poses[7, 3] = nan is not finite")]:
+        ("object_pose_nan", "obs/object_poses", (7, 3), np.nan, "obs/object_poses[7, 3] = nan is not finite"),
+        ("ee_target_s_not_the_actions", "obs/ee_target", (12, 6), 1, "/data/demo_0/obs/ee_target: element [12, 6] (step 12, S) = 1 but the action's S is 0"),
+        ("ee_waypoint_jumps", "obs/ee_waypoint", (5, 0), 2,
+         "/data/demo_0/obs/ee_waypoint: element [5, 0] = 2: 0 at the first step, then the step before's (0) or one more")]:
     CASES.append((name, set_element(dataset, element, value), expected, ()))
 
 

@@ -21,7 +21,7 @@ A bad argument to the `manisoft` module raises `ValueError` (a bad value: the ar
 entry is named) or `RuntimeError` (a call out of order) and changes nothing: the environment steps
 on as if the call had not been made. `evaluate.py` exits 2 with one line naming the flag. `env` is
 `manisoft.make_env("COLL", "clean", seed=0, render=False, privileged=True)` after `env.reset(options={"index": 0})`,
-`zero` its zero action, `vec` is `manisoft.make_vec_env("reach", 2)` after `vec.reset(seed=0)`.
+`zero` its zero action, `ee` the same with `action_mode="ee_pose"`, `vec` is `manisoft.make_vec_env("reach", 2)` after `vec.reset(seed=0)`.
 Test `python_bad_inputs` (`tests/python/test_bad_inputs.py`).
 """, ["call", "raises", "message"])
 
@@ -85,6 +85,15 @@ class BadInputs(unittest.TestCase):
         self.assertEqual(env.step(zero)[4]["steps"], 1)  # every refused call above changed nothing
         env.close()
         self.refused("env.step(zero) after env.close()", lambda: env.step(zero), RuntimeError, "closed")
+        self.refused('make_env("COLL", action_mode="joint")', lambda: manisoft.make_env("COLL", action_mode="joint"), ValueError,
+                     "action_mode = 'joint'")
+        ee = manisoft.make_env("COLL", "clean", seed=0, render=False, action_mode="ee_pose")
+        ee.reset(options={"index": 0})
+        self.refused("ee.step(ee pose with rz = nan)", lambda: ee.step([0.5, 0, 0.9, 0, 0, np.nan, 0]), ValueError,
+                     "entry 5 (rz) is not finite")
+        self.refused("ee.step(zero)", lambda: ee.step(zero), ValueError, "must have shape (7,)")
+        self.refused("ee.expert_action()", ee.expert_action, RuntimeError, "torques")
+        ee.close()
         vec = manisoft.make_vec_env("reach", 2)
         vec.reset(seed=0)
         bad = np.zeros(vec.action_space.shape)
@@ -104,6 +113,7 @@ class BadInputs(unittest.TestCase):
             open(a_file, "w").close()
             for argv, words in [(["--policy", "python:no_such_module:act"], "no_such_module"), (["--jobs", "0"], "--jobs"),
                                 (["--indices", "3", "-1"], "--indices"), (["--chunk-steps", "0"], "--chunk-steps"),
+                                (["--action-mode", "joint"], "--action-mode"), (["--action-repeat", "0"], "--action-repeat"),
                                 (["--out", os.path.join(a_file, "out")], "--out")]:
                 args = argv + ([] if "--out" in argv else ["--out", os.path.join(scratch, "out")])
                 done = subprocess.run([sys.executable, "-m", "evaluate", "--task", "COLL"] + args, capture_output=True, text=True, timeout=120)

@@ -111,6 +111,20 @@ class EvaluateTest(unittest.TestCase):
         (again,) = episodes(replay)
         self.assertEqual((again["success"], again["steps"]), ("True", row["steps"]))
 
+    def test_the_expert_on_the_end_effector_track(self):
+        # its recorded targets sent every 36 control steps; the saved actions are 7-float ee actions
+        out = self.out("ee")
+        self.assertEqual(evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", "expert", "--indices", "2",
+                                        "--action-mode", "ee_pose", "--out", out, "--save-actions"]), 0)
+        (row,) = episodes(out)
+        self.assertEqual((row["success"], row["failure"]), ("True", ""))
+        actions = np.load(os.path.join(out, "actions", "ALN_clean_2.npy"))
+        self.assertEqual(actions.shape, (-(-int(row["steps"]) // 36), 7))
+        with open(os.path.join(out, "results.md")) as f:
+            self.assertIn("action mode ee_pose, 36 control steps an action", f.read())
+        with open(os.path.join(out, "summary.json")) as f:
+            self.assertEqual(json.load(f)["action_mode"], "ee_pose")
+
     def test_failing_python_policies_fail_their_episodes_only(self):
         for name, reason, detail in [("raising", "policy_error", "RuntimeError: model checkpoint missing"),
                                      ("wrong_shape", "bad_action", "shape (4, 7)"),

@@ -95,6 +95,54 @@ class TaskEnvTest(unittest.TestCase):
         with self.assertRaisesRegex(RuntimeError, "episode is over"):
             env.step(np.zeros(61))
 
+    def test_the_end_effector_track_replays_the_experts_targets(self):
+        # the expert's targets recorded on the torque track, sampled at 20 Hz, drive the ee_pose track
+        torque = manisoft.make_env("ALN", "clean", seed=0, render=False)
+        torque.reset(options={"index": 1, "split": "eval"})
+        targets = []
+        while True:
+            action = torque.expert_action()
+            targets.append(torque.expert_target())
+            *_, terminated, truncated, info = torque.step(action)
+            if terminated or truncated:
+                break
+        self.assertTrue(info["success"], info)
+        env = manisoft.make_env("ALN", "clean", seed=0, render=False, action_mode="ee_pose")
+        self.assertEqual((env.action_mode, env.action_repeat), ("ee_pose", 36))
+        self.assertEqual(env.action_space.shape, (7,))
+        obs, info = env.reset(options={"index": 1, "split": "eval"})
+        # every target within the space; the first (the approach: tool down, yawed about the
+        # vertical) has the rotation vector (0, 0, yaw) from the home orientation, S open
+        self.assertTrue(all(env.action_space.contains(t) for t in targets))
+        self.assertLess(abs(targets[0][3]) + abs(targets[0][4]), 1e-9)
+        self.assertEqual(targets[0][6], 0.0)
+        commands, k = [], 0
+        while True:
+            obs, reward, terminated, truncated, info = env.step(targets[min(k, len(targets) - 1)])
+            commands.append(info["ee_command"])
+            k += info["control_steps"]
+            if terminated or truncated:
+                break
+            self.assertEqual(info["control_steps"], 36)
+        self.assertTrue(info["success"], info)
+        self.assertEqual(k, info["steps"])
+        self.assertNotIn("refused", commands)
+        self.assertGreaterEqual(commands.count("line"), 4)
+        with self.assertRaisesRegex(ValueError, "entry 3 \\(rx\\) is not finite"):
+            env.reset(options={"index": 1, "split": "eval"})
+            env.step([0.5, 0, 0.9, float("nan"), 0, 0, 0])
+        with self.assertRaisesRegex(ValueError, "shape \\(7,\\)"):
+            env.step(np.zeros(61))
+        self.assertEqual(env.step(targets[0])[4]["steps"], 36)  # nothing changed by the refused ones
+        with self.assertRaisesRegex(RuntimeError, "record its targets there"):
+            env.expert_target()
+        with self.assertRaisesRegex(RuntimeError, "actions are torques"):
+            env.expert_action()
+        with self.assertRaisesRegex(ValueError, "action_mode = 'joint'"):
+            manisoft.make_env("ALN", action_mode="joint")
+        with self.assertRaisesRegex(ValueError, "action_repeat = 0"):
+            manisoft.make_env("ALN", action_mode="ee_pose", action_repeat=0)
+
     def test_zero_torques_time_out_at_the_horizon(self):
         env = manisoft.make_env("ALN", "clean", seed=0, render=False)
         env.reset(options={"index": 0})

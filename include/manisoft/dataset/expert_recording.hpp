@@ -11,6 +11,11 @@
 //   obs/rod_directors n x 9: element k's directors, column 3 i + j = Q_k(i, j) (rows of Q_k are
 //                     d1, d2, d3 in world coordinates; d3 is the element's tangent)
 //   obs/object_poses  7 per object
+//   obs/ee_target     the end-effector target the actions track (the expert's: the end of its
+//                     current line or ramp) as the end-effector track's action (task::ee_action:
+//                     position, rotation vector from the home orientation, S): one dataset trains
+//                     the torque track (actions) and the end-effector track (obs/ee_target)
+//   obs/ee_waypoint   which target it is: 0 at the first step, one more each time it changes
 //   rewards           1 at the step the task succeeded, else 0; dones 1 at the last step
 // Attributes: task, setting, split, scene (JSON), instruction, instructions_seen and
 // instructions_unseen (JSON arrays), failure; numbers success, steps, seed, scene_index, redraws.
@@ -27,6 +32,7 @@
 #include "manisoft/control/action_layout.hpp"
 #include "manisoft/dataset/episode.hpp"
 #include "manisoft/scene/scene_json.hpp"
+#include "manisoft/task/ee_track.hpp"
 #include "manisoft/task/task_env.hpp"
 
 namespace manisoft::dataset {
@@ -67,13 +73,21 @@ class EpisodeRecorder {
     rod_.resize(t, 3 * (n + 1));
     directors_.resize(t, 9 * n);
     objects_.resize(t, 7 * objects);
+    target_.resize(t, 7);
+    waypoint_.resize(t, 1);
   }
 
-  /// Records the state before the action (torques n x 3, S) about to be stepped.
+  /// Records the state before the action (torques n x 3, S) about to be stepped, and the
+  /// end-effector target those torques track.
   template <typename Matrix>
-  void step(const Matrix& torques, int s) {
+  void step(const Matrix& torques, int s, const math::Pose<double>& ee_target) {
     if (rows_ >= e_.actions.rows()) manisoft::detail::fail("EpisodeRecorder: more steps than the horizon (", e_.actions.rows(), ")");
     const long r = rows_++;
+    const task::EeAction a = task::ee_action(ee_target, s, env_->home_pose().rotation);
+    target_.row(r) = a.transpose();
+    const bool moved = r > 0 && (ee_target.translation != last_target_.translation || ee_target.rotation != last_target_.rotation);
+    waypoint_(r, 0) = r == 0 ? 0.0 : waypoint_(r - 1, 0) + (moved ? 1.0 : 0.0);
+    last_target_ = ee_target;
     control::FlatAction::pack(torques, s, e_.actions.row(r));
     read_state(*env_, e_.states.row(r));
     const auto f = env_->world().soft().end_effector_frame();
@@ -105,6 +119,8 @@ class EpisodeRecorder {
     e.observations["rod_centerline"] = rod_.topRows(t);
     e.observations["rod_directors"] = directors_.topRows(t);
     e.observations["object_poses"] = objects_.topRows(t);
+    e.observations["ee_target"] = target_.topRows(t);
+    e.observations["ee_waypoint"] = waypoint_.topRows(t);
     const scene::SceneSpec& s = env_->spec();
     e.text["task"] = std::string(scene::to_string(s.task));
     e.text["setting"] = std::string(scene::to_string(s.setting));
@@ -125,7 +141,8 @@ class EpisodeRecorder {
  private:
   const task::TaskEnv* env_;
   Episode e_;
-  StepMatrix eef_, gripper_, rod_, directors_, objects_;
+  StepMatrix eef_, gripper_, rod_, directors_, objects_, target_, waypoint_;
+  math::Pose<double> last_target_;
   long rows_ = 0;
 };
 

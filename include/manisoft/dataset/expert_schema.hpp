@@ -1,14 +1,16 @@
 // The schema of an expert episode file (what expert_recording.hpp records and episode_file.hpp
 // stores; the ManiSoft benchmark paper, section 3.5), checked element by element:
 //   datasets   actions, states, rewards, dones and obs/eef_pose, obs/gripper, obs/rod_centerline,
-//              obs/rod_directors, obs/object_poses, each with its dtype and shape (n elements of the
-//              benchmark arm, the scene's object count); images (uint8 F x H x W x 3, with int64
-//              <name>_steps under images/) are optional; anything else is refused
+//              obs/rod_directors, obs/object_poses, obs/ee_target, obs/ee_waypoint, each with its
+//              dtype and shape (n elements of the benchmark arm, the scene's object count); images
+//              (uint8 F x H x W x 3, with int64 <name>_steps under images/) are optional; anything
+//              else is refused
 //   values     actions within the arm's actuation limits (rod::ActuationLimits as the arm world
 //              applies them: |tau_1|, |tau_2| <= bend and |tau_3| <= twist, element 0 on the
-//              clamped base none), S in {0, 1}; dones 0 or
-//              1 with the last 1 and only the last; rewards 0 or 1, only the last may be 1, and it
-//              is 1 exactly when success is
+//              clamped base none), S in {0, 1}; obs/ee_target's S the action's S; obs/ee_waypoint
+//              0 at the first step, then the step before's or one more; dones 0 or 1 with the last
+//              1 and only the last; rewards 0 or 1, only the last may be 1, and it is 1 exactly
+//              when success is
 //   attributes task, setting, split, scene, instruction, instructions_seen, instructions_unseen,
 //              failure (strings); success, steps, seed, scene_index, redraws (numbers); optional
 //              generate_args (string); the scene a valid scene (scene_json.hpp's reader) whose
@@ -96,7 +98,9 @@ inline void check_expert_layout(const std::filesystem::path& file, const Episode
       {"obs/gripper", {"float32", {t, 2}}},
       {"obs/rod_centerline", {"float32", {t, static_cast<hsize_t>(3 * (elements + 1))}}},
       {"obs/rod_directors", {"float32", {t, static_cast<hsize_t>(9 * elements)}}},
-      {"obs/object_poses", {"float32", {t, static_cast<hsize_t>(7 * objects)}}}};
+      {"obs/object_poses", {"float32", {t, static_cast<hsize_t>(7 * objects)}}},
+      {"obs/ee_target", {"float32", {t, 7}}},
+      {"obs/ee_waypoint", {"float32", {t, 1}}}};
   for (const auto& [field, expected] : layout) schema_detail::require_dataset(f, at, field, expected.first, expected.second);
   for (const std::string& name : f.children(at.demo))
     if (!layout.count(name) && name != "obs" && name != "images") at.fail(name, "unexpected member (not in the expert episode layout)");
@@ -118,6 +122,8 @@ inline void check_expert_values(const std::filesystem::path& file, const Episode
   const schema_detail::Where at{file.string(), demo_path(e.index)};
   const long t = e.steps();
   const int s_column = control::FlatAction::gripper(elements);
+  const StepMatrix& target = e.observations.at("ee_target");
+  const StepMatrix& waypoint = e.observations.at("ee_waypoint");
   for (long r = 0; r < t; ++r) {
     for (int c = 0; c < s_column; ++c) {
       const double a = e.actions(r, c), limit = c < 3 ? 0.0 : limits.limit(c % 3);  // element 0: the clamped base, no torque
@@ -127,6 +133,10 @@ inline void check_expert_values(const std::filesystem::path& file, const Episode
     }
     const double s = e.actions(r, s_column);
     if (s != 0.0 && s != 1.0) at.fail("actions", "element [", r, ", ", s_column, "] (step ", r, ", S) = ", s, ": S must be 0 or 1");
+    if (const double ts = target(r, 6); ts != s) at.fail("obs/ee_target", "element [", r, ", 6] (step ", r, ", S) = ", ts, " but the action's S is ", s);
+    const double w = waypoint(r, 0), before = r == 0 ? 0.0 : waypoint(r - 1, 0);
+    if (r == 0 ? w != 0.0 : w != before && w != before + 1)
+      at.fail("obs/ee_waypoint", "element [", r, ", 0] = ", w, ": 0 at the first step, then the step before's (", before, ") or one more");
     const int last = r + 1 == t ? 1 : 0;
     if (e.dones[static_cast<std::size_t>(r)] != last)
       at.fail("dones", "element [", r, "] = ", static_cast<int>(e.dones[static_cast<std::size_t>(r)]), ": dones must be 0 before the last step and 1 at it (step ", t - 1, ")");

@@ -100,6 +100,10 @@ class Expert : private detail::GraspChoice {
   }
 
   ExpertPhase phase() const { return phase_; }
+  /// The end-effector pose the executor tracks now: the end of the current line or ramp (the
+  /// home pose after reset()); what an end-effector-track policy would command
+  /// (ee_track.hpp).
+  const Pose& target() const { return target_; }
   int move() const { return move_; }
   int moves() const { return moves_; }
   /// Why the expert gave up (none while it has not): a path the executor refused, a missed grasp.

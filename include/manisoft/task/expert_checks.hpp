@@ -41,6 +41,17 @@ struct LinePlan {
   std::uint64_t held_near = 0;  ///< objects the held one or the gripper starts or ends near: not held against it (holding)
 };
 
+/// Control steps of a straight line `distance` long, timed by ModelExecutor::track_line's profile
+/// (paths.cruise) at peak end-effector speed `peak` (m/s) and, when `max_accel` > 0, peak
+/// acceleration at most `max_accel` (m/s^2); at least paths.min_segment_steps.
+inline int timed_line_steps(const ExpertConfig::Paths& paths, double control_dt, double distance, double peak, double max_accel) {
+  using Executor = TaskEnv::Executor;
+  double seconds = Executor::peak_speed_ratio(paths.cruise) * distance / peak;
+  // the timing's peak acceleration is shape x distance / T^2
+  if (max_accel > 0) seconds = std::max(seconds, std::sqrt(Executor::peak_acceleration_ratio(paths.cruise) * distance / max_accel));
+  return std::max(paths.min_segment_steps, static_cast<int>(std::ceil(seconds / control_dt)));
+}
+
 /// The expert's line checks on its planning copy of the executor (a base of Expert).
 class ExpertChecks : protected ExpertLegs {
  protected:
@@ -53,14 +64,10 @@ class ExpertChecks : protected ExpertLegs {
   /// object `held`, also within carry.grip_share of what the grip holds.
   int line_steps(double distance, bool loaded, double peak_speed, int held) const {
     const double peak = peak_speed > 0 ? peak_speed : loaded ? config_.carry.peak_speed : config_.paths.peak_speed;
-    double seconds = Executor::peak_speed_ratio(config_.paths.cruise) * distance / peak;
-    if (loaded && config_.carry.grip_share > 0 && held >= 0) {
-      // the timing's peak acceleration is shape x distance / T^2
-      const double shape = Executor::peak_acceleration_ratio(config_.paths.cruise);
-      const double accel = config_.carry.grip_share * env_->gripper_parameters().max_hold_force / asset_of(held).mass;
-      seconds = std::max(seconds, std::sqrt(shape * distance / accel));
-    }
-    return std::max(config_.paths.min_segment_steps, static_cast<int>(std::ceil(seconds / env_->control_dt())));
+    double max_accel = 0;
+    if (loaded && config_.carry.grip_share > 0 && held >= 0)
+      max_accel = config_.carry.grip_share * env_->gripper_parameters().max_hold_force / asset_of(held).mass;
+    return timed_line_steps(config_.paths, env_->control_dt(), distance, peak, max_accel);
   }
   /// The node speed bound of a line, m per control step.
   double node_step(bool loaded) const { return (loaded ? config_.carry.node_speed : config_.paths.node_speed) * env_->control_dt(); }
