@@ -443,19 +443,28 @@ class TaskEnvironment {
 
   /// Reads a flat action into `torques`; returns S. Refuses before anything changes.
   int read_action(const py::handle& given, Array3& torques) const {
+    const auto values = finite_action(given, Action::size(n_), "step: action must have shape (" + std::to_string(Action::size(n_)) + ",) (n x 3 torques then S)",
+                                      [&](int i) { return Action::describe(i, n_); });
+    return Action::unpack(values.unchecked<1>(), torques);
+  }
+
+  /// A step's action as float64: a real 1-D array of `size` finite entries, else ValueError (the
+  /// dtype; `shape_text` with the shape given; the entry i that is not finite, described by
+  /// describe(i)). Refused before anything changes.
+  template <typename Describe>
+  static py::array_t<double> finite_action(const py::handle& given, py::ssize_t size, const std::string& shape_text, Describe describe) {
     const py::array action = action_array(given, "step: action");
     const char kind = action.dtype().kind();
     if (kind != 'f' && kind != 'i' && kind != 'u')
       throw py::value_error("step: action dtype must be real (float64 preferred), got " + std::string(py::str(action.dtype())));
-    if (action.ndim() != 1 || action.shape(0) != Action::size(n_))
-      throw py::value_error("step: action must have shape (" + std::to_string(Action::size(n_)) + ",) (n x 3 torques then S), got " +
-                            std::string(py::str(py::handle(action).attr("shape"))));
-    const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(action);
+    if (action.ndim() != 1 || action.shape(0) != size)
+      throw py::value_error(shape_text + ", got " + std::string(py::str(py::handle(action).attr("shape"))));
+    auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(action);
     const auto v = values.unchecked<1>();
     for (py::ssize_t i = 0; i < v.shape(0); ++i)
       if (!std::isfinite(v(i)))
-        throw py::value_error("step: action entry " + std::to_string(i) + " (" + Action::describe(static_cast<int>(i), n_) + ") is not finite");
-    return Action::unpack(v, torques);
+        throw py::value_error("step: action entry " + std::to_string(i) + " (" + describe(static_cast<int>(i)) + ") is not finite");
+    return values;
   }
 
   static ms::task::EeTrackConfig track_config(int action_repeat) {
@@ -468,18 +477,10 @@ class TaskEnvironment {
   /// One "ee_pose" action: the target commanded, then action_repeat control steps (fewer when the
   /// episode ends). The reward is 1 when the task succeeds within them.
   py::tuple step_end_effector(const py::handle& given) {
-    const py::array action = action_array(given, "step: action");
-    const char kind = action.dtype().kind();
-    if (kind != 'f' && kind != 'i' && kind != 'u')
-      throw py::value_error("step: action dtype must be real (float64 preferred), got " + std::string(py::str(action.dtype())));
-    if (action.ndim() != 1 || action.shape(0) != 7)
-      throw py::value_error("step: an ee_pose action must have shape (7,) (position, rotation vector, S), got " +
-                            std::string(py::str(py::handle(action).attr("shape"))));
-    const auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(action);
-    const auto v = values.unchecked<1>();
     static constexpr const char* names[7] = {"x", "y", "z", "rx", "ry", "rz", "S"};
-    for (py::ssize_t i = 0; i < 7; ++i)
-      if (!std::isfinite(v(i))) throw py::value_error("step: action entry " + std::to_string(i) + " (" + names[i] + ") is not finite");
+    const auto values = finite_action(given, 7, "step: an ee_pose action must have shape (7,) (position, rotation vector, S)",
+                                      [](int i) { return std::string(names[i]); });
+    const auto v = values.unchecked<1>();
     ms::task::EeAction a;
     for (int c = 0; c < 7; ++c) a(c) = v(c);
     const ms::math::Pose<double> target = ms::task::ee_target_of(a, env_.home_pose().rotation);
