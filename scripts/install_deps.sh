@@ -16,6 +16,8 @@ packages+=(pybind11-dev python3-dev)
 packages+=(python3-pip python3-setuptools python3-wheel python3-venv)
 # the evaluation harness's policy-server client (openpi's websocket + msgpack protocol)
 packages+=(python3-websockets python3-msgpack python3-msgpack-numpy)
+# the learned reference policies (PyTorch on CPU; OpenBLAS so its matrix products use a tuned BLAS)
+packages+=(python3-torch libopenblas0-pthread)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -21,6 +21,10 @@ action is 7 floats (target position, rotation vector, S; manisoft.make_env(..., 
 "ee_pose")) tracked by the model executor for --action-repeat control steps (default 36: 20 Hz);
 the expert then sends the targets it tracked at each control step of its own episode on the torque
 track (run first), every --action-repeat steps.
+--observation privileged hands a python: policy the environment's privileged state instead of the
+image (make_env(..., render=False, privileged=True)) and, as obs["scene"], the episode's scene JSON
+(its objects, assets and goal): the bound a perfect perception gives. A python: module's reset(),
+if it has one, is called before each episode.
 
 Scenes: the evaluation split (never drawn by dataset generation), eval indices 0, 1, 2, ... of each
 task and setting, the first K of each target-object category (STK: K in all); horizon T = manisoft.HORIZON (1500).
@@ -125,8 +129,14 @@ class TimedPolicy:
     still running then is abandoned (PolicyFailure "policy_timeout", hung). Whatever the policy
     raises, SystemExit and KeyboardInterrupt included, is raised in the caller."""
 
-    def __init__(self, function, timeout):
-        self.function, self.timeout = function, timeout
+    def __init__(self, function, timeout, reset=None):
+        self.function, self.timeout, self.reset = function, timeout, reset
+
+    def start(self, task, setting, index):
+        """The module's reset(), if it has one, at the start of every episode."""
+        del task, setting, index
+        if self.reset is not None:
+            self.reset()
 
     def __call__(self, obs):
         box, done = {}, threading.Event()
@@ -303,7 +313,8 @@ def load_python_policy(spec, extra_path):
     function = getattr(module, function_name, None)
     if not callable(function):
         raise ValueError(f"--policy {spec}: {module_name} has no callable '{function_name}'")
-    return function
+    reset = getattr(module, "reset", None)
+    return function, reset if callable(reset) else None
 
 
 def check_spec(spec):
@@ -346,8 +357,9 @@ class Worker:
         key = (task, setting)
         if key not in self.envs:
             width, height = self.args.image_size
-            needs_image = not (self.args.policy in ("expert", "random") or self.args.policy.startswith("replay:"))
-            self.envs[key] = manisoft.make_env(task, setting, seed=self.args.seed, split="eval", render=needs_image,
+            privileged = self.args.observation == "privileged"
+            needs_image = not (privileged or self.args.policy in ("expert", "random") or self.args.policy.startswith("replay:"))
+            self.envs[key] = manisoft.make_env(task, setting, seed=self.args.seed, split="eval", render=needs_image, privileged=privileged,
                                                camera={"width": width, "height": height}, action_mode=self.args.action_mode,
                                                action_repeat=self.args.action_repeat)
         return self.envs[key]
@@ -363,7 +375,8 @@ class Worker:
         if spec.startswith("replay:"):
             return ReplayPolicy(spec[len("replay:"):])
         if spec.startswith("python:"):
-            return TimedPolicy(load_python_policy(spec, self.args.python_path), self.args.policy_timeout)
+            function, reset = load_python_policy(spec, self.args.python_path)
+            return TimedPolicy(function, self.args.policy_timeout, reset)
         return WebsocketPolicy(spec, self.args.policy_timeout)
 
     def run(self, episode):
@@ -379,6 +392,9 @@ class Worker:
         obs, info = env.reset(seed=self.args.seed, options={"index": index, "split": "eval", "instruction": instruction,
                                                           "instruction_index": number // 2})
         size = env.action_space.shape[0]
+        scene = env.scene_json() if self.args.observation == "privileged" else None
+        if scene is not None:
+            obs["scene"] = scene
         actions, failure, detail, hung = [], info["failure"], "", False
         chunk, used, started = None, 0, True
         try:
@@ -402,6 +418,8 @@ class Worker:
             used += 1
             actions.append(action)
             obs, _, terminated, truncated, info = env.step(action)
+            if scene is not None:
+                obs["scene"] = scene
             failure = info["failure"]
         if self.args.save_actions:
             path = os.path.join(self.args.out, "actions", f"{task}_{setting}_{index}.npy")
@@ -467,7 +485,8 @@ def write_outputs(out, args, episodes, wall):
     rows = table_rows(episodes)
     write_csv(os.path.join(out, "results.csv"), list(rows[0].keys()) if rows else [], rows)
     track = "torque" if args.action_mode == "torque" else f"ee_pose, {args.action_repeat} control steps an action"
-    lines = [f"# ManiSoft evaluation: policy `{args.policy}`, action mode {track}", "",
+    seen = "" if args.observation == "image" else ", privileged observation"
+    lines = [f"# ManiSoft evaluation: policy `{args.policy}`, action mode {track}{seen}", "",
              f"Held-out (eval) scenes, seed {args.seed}, " + (f"eval indices {args.indices}" if args.indices else
              f"up to {args.episodes_per_category or '20 (clean) / 40 (randomized)'} episodes per target category") + ", "
              f"horizon {HORIZON}; {len(episodes)} episodes in {wall:.0f} s. ACC: success % with its 95% Wilson interval; "
@@ -490,7 +509,7 @@ def write_outputs(out, args, episodes, wall):
     for (task, setting, reason), n in sorted(Counter((e["task"], e["setting"], e["failure"]) for e in episodes if not e["success"]).items()):
         lines.append(f"| {task} | {setting} | {reason} | {n} |")
     write_text(os.path.join(out, "results.md"), "\n".join(lines) + "\n")
-    summary = {"policy": args.policy, "action_mode": args.action_mode, "action_repeat": args.action_repeat, "seed": args.seed, "episodes": len(episodes), "wall_s": round(wall, 1),
+    summary = {"policy": args.policy, "observation": args.observation, "action_mode": args.action_mode, "action_repeat": args.action_repeat, "seed": args.seed, "episodes": len(episodes), "wall_s": round(wall, 1),
                "success_rate": sum(e["success"] for e in episodes) / max(1, len(episodes)),
                "tables": [{k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in r.items()} for r in rows if r["category"] == "all"]}
     write_text(os.path.join(out, "summary.json"), json.dumps(summary, indent=2, allow_nan=False) + "\n")
@@ -529,6 +548,8 @@ def parse_args(argv):
                    help="torque: the paper's 3n + 1 torques and S a control step; ee_pose: an end-effector target "
                         "(position, rotation vector) and S tracked by the model executor for --action-repeat control steps")
     p.add_argument("--action-repeat", type=int, default=36, help="control steps an ee_pose action is tracked (36: 20 Hz)")
+    p.add_argument("--observation", default="image", choices=("image", "privileged"),
+                   help="what a python: or ws:// policy sees: the image and instruction, or the privileged state and the scene JSON")
     p.add_argument("--policy-timeout", type=float, default=60.0, help="seconds a policy call may take")
     p.add_argument("--image-size", type=int, nargs=2, default=[514, 514], metavar=("W", "H"))
     p.add_argument("--save-actions", action="store_true", help="write each episode's actions to OUT/actions/ (for replay:OUT)")
@@ -579,7 +600,7 @@ def parse_args(argv):
 # ---- the run's progress: run.json (its arguments) and episodes.jsonl (each finished episode)
 
 RUN_ARGUMENTS = ("policy", "seed", "tasks", "settings", "episodes_per_category", "indices", "max_scan", "chunk_steps",
-                 "policy_timeout", "image_size", "action_mode", "action_repeat")
+                 "policy_timeout", "image_size", "action_mode", "action_repeat", "observation")
 
 
 def run_arguments(args):

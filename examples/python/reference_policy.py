@@ -1,0 +1,376 @@
+#!/usr/bin/env python3
+"""The reference policy from privileged state on the end-effector track: behaviour cloning of the
+expert's end-effector targets (obs/ee_target of a generated dataset) by a small MLP per task,
+trained on CPU with PyTorch (Debian python3-torch), evaluated by evaluate.py like any policy. It is
+the bound a perfect perception gives a policy that learns from the dataset.
+
+    generate_dataset --tasks ALN,COLL --clean 400 --randomized 400 --seed 0 --out data/ref
+    /usr/bin/python3 -m manisoft.reference_policy train --data data/ref --out ref/models
+    MANISOFT_REFERENCE_MODELS=ref/models /usr/bin/python3 -m manisoft.evaluate --task ALN --setting all \\
+        --policy python:manisoft.reference_policy:act --observation privileged --action-mode ee_pose --out ref/eval
+
+Observation (what evaluate.py --observation privileged hands over: the environment's privileged
+state and the episode's scene JSON, whose goal and assets a perfect perception would read off the
+image and the instruction): the end-effector frame, the finger width and S, the task's objects in
+the goal's roles (the moved object first; COLL then the container), OVR's obstacle, the goal
+(ALN, OVR: the marker's pose), the moved object's asset, and the policy's own memory: its previous
+command, the end effector's displacement since its last call, the control steps since the command
+was first sent.
+Action: the end-effector track's 7 floats (target position, rotation vector from the home
+orientation, S), sent every --action-repeat control steps (evaluate.py's default, 36: 20 Hz).
+Model: an MLP (3 x 256, SiLU) to two answers: whether to switch to a new command now (a logit),
+and the next command (position and rotation normalised by the training data's mean and spread,
+S as a logit). The policy keeps its previous command until the switch logit is positive, so the
+track is not restarted by the regression's small differences, and the next command is never an
+average of two waypoints: it is the one after the previous command's.
+Training samples: every --stride-th control step t of the train mask's episodes, the previous
+command being the expert's target at t - --repeat (the control steps between commands); the
+switch label says whether the expert's target changed since, the next command is the target of
+the waypoint after that one (obs/ee_waypoint). Losses: mean squared error of the pose, binary
+cross-entropy of S and of the switch. The dataset's valid mask gives the held-out loss. A
+checkpoint is written after every epoch (temporary name, then renamed); --resume continues from it
+and ends with the weights an uninterrupted run gives.
+"""
+import argparse
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+TASKS = ("COLL", "ALN", "OVR")
+MAX_OBJECTS = 2  # the objects of a task's goal roles (COLL: object, container; ALN, OVR: the object)
+
+
+# ---- features
+
+def rotation_of_quaternion(q):
+    """(..., 4) w x y z -> (..., 3, 3)."""
+    w, x, y, z = (q[..., i] for i in range(4))
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
+
+
+def pose_of_json(p):
+    return np.asarray(p["position"], dtype=np.float64), np.asarray(p["rotation"], dtype=np.float64)
+
+
+class SceneRoles:
+    """What a task's scene fixes for an episode: the objects in their goal roles, the goal pose,
+    the obstacle and the moved object's asset."""
+
+    def __init__(self, scene):
+        self.task = scene["task"]
+        if self.task not in TASKS:
+            raise ValueError(f"the reference policy knows the tasks {', '.join(TASKS)}, not {self.task}")
+        goal = scene["goal"]
+        self.roles = [goal["object"]] + ([goal["container"]] if self.task == "COLL" else [])
+        self.asset = scene["objects"][goal["object"]]["asset_id"]
+        zero = (np.zeros(3), np.eye(3))
+        self.goal = pose_of_json(goal["goal_pose"]) if "goal_pose" in goal else zero
+        self.obstacle = pose_of_json(scene["obstacles"][goal["obstacle"]]["pose"])[0] if "obstacle" in goal else np.zeros(3)
+
+
+def six(r):
+    """A rotation's first two columns (..., 6): continuous, unlike angles."""
+    return np.concatenate([r[..., :, 0], r[..., :, 1]], -1)
+
+
+def features(roles, ee_position, ee_rotation, width, s, object_positions, object_rotations, memory, assets):
+    """One row of inputs (see the module's comment). object_* are the scene's objects in its order;
+    memory: the policy's previous command (7), the end effector's displacement since and the
+    control steps since that command was first sent."""
+    previous, displacement, age = memory
+    parts = [ee_position, six(ee_rotation), [width * 10.0, s], previous[:3] - ee_position, previous[3:], displacement * 10.0,
+             [min(age, 720) / 360.0]]
+    for k in range(MAX_OBJECTS):
+        if k < len(roles.roles):
+            p, r = object_positions[roles.roles[k]], object_rotations[roles.roles[k]]
+            parts += [p, p - ee_position, six(r), [1.0]]
+        else:
+            parts += [np.zeros(3), np.zeros(3), np.zeros(6), [0.0]]
+    goal_p, goal_r = roles.goal
+    moved = object_positions[roles.roles[0]]
+    parts += [goal_p, goal_p - moved, six(goal_r), roles.obstacle, roles.obstacle - ee_position]
+    one_hot = np.zeros(len(assets))
+    if roles.asset in assets:
+        one_hot[assets.index(roles.asset)] = 1.0
+    parts.append(one_hot)
+    return np.concatenate([np.asarray(p, dtype=np.float64).ravel() for p in parts])
+
+
+def home_command(ee_position):
+    """The track's target after reset: the home pose (rotation vector 0 from the home orientation), S = 0."""
+    return np.concatenate([ee_position, np.zeros(4)])
+
+
+# ---- the dataset
+
+def read_episodes(directory, task):
+    """The task's episodes of a generated dataset: (mask name, scene, arrays) each."""
+    import h5py
+    out = []
+    with h5py.File(os.path.join(directory, "dataset.hdf5"), "r") as f:
+        masks = {name: {m.decode() for m in f["mask"][name][()]} for name in ("train", "valid")}
+        for demo in sorted(f["data"].keys(), key=lambda d: int(d.split("_")[1])):
+            g = f["data"][demo]
+            if g.attrs["task"] != task:
+                continue
+            mask = "train" if demo in masks["train"] else "valid"
+            names = ("eef_pose", "gripper", "object_poses", "ee_target", "ee_waypoint")
+            arrays = {k: g["obs"][k][()].astype(np.float64) for k in names}
+            out.append((mask, json.loads(g.attrs["scene"]), arrays))
+    return out
+
+
+def samples_of(episode, stride, repeat, assets):
+    """The episode's training rows at every stride-th step t: the inputs with the command sent at
+    t - repeat as the previous one; whether the expert's target changed since (the switch label);
+    the target of the waypoint after the previous command's (the next command)."""
+    _, scene, a = episode
+    roles = SceneRoles(scene)
+    eef, grip, objects, target = a["eef_pose"], a["gripper"], a["object_poses"], a["ee_target"]
+    waypoint = a["ee_waypoint"][:, 0].astype(np.int64)
+    steps = len(target)
+    first = np.searchsorted(waypoint, np.arange(waypoint[-1] + 2))  # first step of each waypoint (steps if none)
+    k = objects.shape[1] // 7
+    objects = objects.reshape(steps, k, 7)
+    ee_rot = rotation_of_quaternion(eef[:, 3:])
+    obj_rot = rotation_of_quaternion(objects[..., 3:])
+    xs, ys = [], []
+    for t in range(0, steps, stride):
+        if t >= repeat:
+            w = waypoint[t - repeat]
+            previous, age, switch = target[t - repeat], t - first[w], waypoint[t] != w
+            following = target[first[w + 1]] if first[w + 1] < steps else previous
+            before = t - repeat
+        else:  # the first command: the track holds the home pose
+            previous, age, switch, following, before = home_command(eef[0, :3]), t, True, target[0], 0
+        x = features(roles, eef[t, :3], ee_rot[t], grip[t, 0], grip[t, 1], objects[t, :, :3], obj_rot[t],
+                     (previous, eef[t, :3] - eef[before, :3], age), assets)
+        xs.append(x)
+        ys.append(np.concatenate([following, [float(switch)]]))
+    return xs, ys
+
+
+def build_dataset(directory, task, stride, repeat):
+    episodes = read_episodes(directory, task)
+    if not episodes:
+        raise ValueError(f"{directory}: no {task} episodes")
+    assets = sorted({SceneRoles(e[1]).asset for e in episodes if e[0] == "train"})
+    split = {"train": ([], []), "valid": ([], [])}
+    for e in episodes:
+        xs, ys = samples_of(e, stride, repeat, assets)
+        split[e[0]][0].extend(xs)
+        split[e[0]][1].extend(ys)
+    arrays = {m: (np.asarray(x, dtype=np.float32), np.asarray(y, dtype=np.float32)) for m, (x, y) in split.items() if x}
+    counts = {m: sum(1 for e in episodes if e[0] == m) for m in ("train", "valid")}
+    return arrays, assets, counts
+
+
+# ---- the model
+
+def build_model(torch, inputs, width=256, depth=3):
+    layers, n = [], inputs
+    for _ in range(depth):
+        layers += [torch.nn.Linear(n, width), torch.nn.SiLU()]
+        n = width
+    layers.append(torch.nn.Linear(n, 8))
+    return torch.nn.Sequential(*layers)
+
+
+class Normaliser:
+    def __init__(self, x, y):
+        self.x_mean, self.x_std = x.mean(0), x.std(0) + 1e-6
+        self.y_mean, self.y_std = y[:, :6].mean(0), y[:, :6].std(0) + 1e-6
+
+    def state(self):
+        return {k: v.tolist() for k, v in vars(self).items()}
+
+    @staticmethod
+    def of_state(state):
+        n = Normaliser.__new__(Normaliser)
+        for k, v in state.items():
+            setattr(n, k, np.asarray(v, dtype=np.float32))
+        return n
+
+
+def loss_of(torch, out, y, norm):
+    """Mean squared error of the next command's normalised pose, binary cross-entropy of its S and
+    of the switch."""
+    target = (y[:, :6] - torch.from_numpy(norm.y_mean)) / torch.from_numpy(norm.y_std)
+    pose = ((out[:, :6] - target) ** 2).mean()
+    bce = torch.nn.functional.binary_cross_entropy_with_logits
+    return pose + bce(out[:, 6], (y[:, 6] >= 0.5).float()) + bce(out[:, 7], y[:, 7])
+
+
+def train_task(args, task, torch):
+    path = os.path.join(args.out, f"{task}.pt")
+    checkpoint = path + ".checkpoint"
+    data, assets, counts = build_dataset(args.data, task, args.stride, args.repeat)
+    x, y = data["train"]
+    norm = Normaliser(x, y)
+    xn = torch.from_numpy((x - norm.x_mean) / norm.x_std)
+    yt = torch.from_numpy(y)
+    valid = None
+    if "valid" in data:
+        vx, vy = data["valid"]
+        valid = (torch.from_numpy((vx - norm.x_mean) / norm.x_std), torch.from_numpy(vy))
+    torch.manual_seed(args.seed)
+    model = build_model(torch, x.shape[1], args.width, args.depth)
+    optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
+    epoch, history = 0, []
+    generator = torch.Generator().manual_seed(args.seed)
+    if args.resume and os.path.exists(checkpoint):
+        saved = torch.load(checkpoint)
+        model.load_state_dict(saved["model"])
+        optimiser.load_state_dict(saved["optimiser"])
+        generator.set_state(saved["generator"])
+        epoch, history = saved["epoch"], saved["history"]
+        print(f"{task}: resumed after epoch {epoch}", flush=True)
+    print(f"{task}: {counts['train']} train / {counts['valid']} valid episodes, {len(x)} samples of {x.shape[1]} inputs", flush=True)
+    t0 = time.perf_counter()
+    scheduler_gamma = args.lr_decay ** (1.0 / max(args.epochs, 1))
+    stop = args.epochs if args.stop_after is None else min(args.epochs, epoch + args.stop_after)
+    while epoch < stop:
+        for group in optimiser.param_groups:
+            group["lr"] = args.lr * scheduler_gamma ** epoch
+        model.train()
+        order = torch.randperm(len(xn), generator=generator)
+        total = 0.0
+        for start in range(0, len(order), args.batch):
+            idx = order[start:start + args.batch]
+            loss = loss_of(torch, model(xn[idx]), yt[idx], norm)
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+            total += loss.item() * len(idx)
+        epoch += 1
+        model.eval()
+        with torch.no_grad():
+            held_out = loss_of(torch, model(valid[0]), valid[1], norm).item() if valid else None
+        history.append((epoch, total / len(xn), held_out))
+        shown = "none (no valid episodes)" if held_out is None else f"{held_out:.4f}"
+        print(f"{task} epoch {epoch}/{args.epochs}: train loss {total / len(xn):.4f}, held-out loss {shown}, "
+              f"{time.perf_counter() - t0:.0f} s", flush=True)
+        tmp = checkpoint + ".tmp"
+        torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(), "generator": generator.get_state(),
+                    "epoch": epoch, "history": history}, tmp)
+        os.replace(tmp, checkpoint)
+    if epoch < args.epochs:
+        print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
+        return None
+    tmp = path + ".tmp"
+    torch.save({"model": model.state_dict(), "inputs": x.shape[1], "width": args.width, "depth": args.depth,
+                "norm": norm.state(), "assets": assets, "task": task, "history": history, "repeat": args.repeat}, tmp)
+    os.replace(tmp, path)
+    print(f"{task}: model -> {path}", flush=True)
+    return model
+
+
+def train(args):
+    import torch
+    torch.set_num_threads(args.threads)
+    os.makedirs(args.out, exist_ok=True)
+    return {task: train_task(args, task, torch) for task in args.tasks.split(",")}
+
+
+# ---- acting (evaluate.py: python:manisoft.reference_policy:act)
+
+class Policy:
+    """One task's model and its memory of the episode: its previous command, the end effector's
+    position then, the control steps since the command was first sent. At each call it keeps the
+    previous command unless the switch logit is positive; then it sends the predicted next one."""
+
+    def __init__(self, path, torch):
+        saved = torch.load(path)
+        self.torch = torch
+        self.model = build_model(torch, saved["inputs"], saved["width"], saved["depth"])
+        self.model.load_state_dict(saved["model"])
+        self.model.eval()
+        self.norm = Normaliser.of_state(saved["norm"])
+        self.assets = saved["assets"]
+        self.repeat = saved["repeat"]
+        self.reset()
+
+    def reset(self):
+        self.previous = self.position = None
+        self.age = 0
+
+    def __call__(self, obs, roles):
+        ee = np.asarray(obs["end_effector"])
+        p, r = ee[:3, 3], ee[:3, :3]
+        if self.previous is None:
+            self.previous, self.position = home_command(p), p.copy()
+        poses = np.asarray(obs["object_poses"])
+        x = features(roles, p, r, float(obs["gripper_width"]), float(obs["gripper_state"]), poses[:, :3, 3], poses[:, :3, :3],
+                     (self.previous, p - self.position, self.age), self.assets)
+        with self.torch.no_grad():
+            out = self.model(self.torch.from_numpy(((x - self.norm.x_mean) / self.norm.x_std).astype(np.float32))[None])[0].numpy()
+        if out[7] > 0:
+            action = np.empty(7)
+            action[:6] = out[:6] * self.norm.y_std + self.norm.y_mean
+            action[6] = 1.0 if out[6] > 0 else 0.0
+            self.previous, self.age = action, 0
+        self.position = p.copy()
+        self.age += self.repeat
+        return self.previous.copy()
+
+
+_models = {}
+_episode = {"scene": None, "roles": None}
+
+
+def reset():
+    """Called by evaluate.py at the start of every episode: forgets the previous command."""
+    _episode["scene"] = None
+    for m in _models.values():
+        m.reset()
+
+
+def act(obs):
+    """The harness's python:manisoft.reference_policy:act (--observation privileged --action-mode
+    ee_pose): the next end-effector target. The models are $MANISOFT_REFERENCE_MODELS/<TASK>.pt."""
+    import torch
+    if _episode["scene"] != obs["scene"]:
+        _episode["scene"], _episode["roles"] = obs["scene"], SceneRoles(json.loads(obs["scene"]))
+    task = _episode["roles"].task
+    if task not in _models:
+        directory = os.environ.get("MANISOFT_REFERENCE_MODELS")
+        if not directory:
+            raise RuntimeError("set MANISOFT_REFERENCE_MODELS to a directory written by reference_policy.py train")
+        torch.set_num_threads(1)
+        _models[task] = Policy(os.path.join(directory, f"{task}.pt"), torch)
+    return _models[task](obs, _episode["roles"])
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description="The privileged-state reference policy on the end-effector track: train")
+    sub = p.add_subparsers(dest="command", required=True)
+    t = sub.add_parser("train", help="train one model per task on a generated dataset")
+    t.add_argument("--data", required=True, help="a dataset directory written by generate_dataset")
+    t.add_argument("--out", required=True, help="directory for <TASK>.pt")
+    t.add_argument("--tasks", default="ALN,COLL")
+    t.add_argument("--epochs", type=int, default=30)
+    t.add_argument("--batch", type=int, default=512)
+    t.add_argument("--lr", type=float, default=1e-3)
+    t.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
+    t.add_argument("--width", type=int, default=256)
+    t.add_argument("--depth", type=int, default=3)
+    t.add_argument("--stride", type=int, default=2, help="a sample every this many control steps")
+    t.add_argument("--repeat", type=int, default=36, help="control steps between the policy's commands")
+    t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--threads", type=int, default=2)
+    t.add_argument("--resume", action="store_true", help="continue from the checkpoint of a killed run")
+    t.add_argument("--stop-after", type=int, default=None, help="stop after this many epochs of this run (a time-limited job), "
+                   "leaving the checkpoint for --resume")
+    args = p.parse_args(argv)
+    train(args)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
