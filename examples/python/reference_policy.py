@@ -25,8 +25,8 @@ track is not restarted by the regression's small differences, and the next comma
 average of two waypoints: it is the one after the previous command's.
 Training samples: every --stride-th control step t of the train mask's episodes, the previous
 command being the expert's target at t - --repeat (the control steps between commands); the
-switch label says whether the expert's target changed since, the next command is the target of
-the waypoint after that one (obs/ee_waypoint). Losses: mean squared error of the pose, binary
+switch label says whether the expert's command (target or S) changed since, the next command is
+the one after that one, as a change from it (position and rotation vector differences, S). Losses: mean squared error of the pose, binary
 cross-entropy of S and of the switch. The dataset's valid mask gives the held-out loss. A
 checkpoint is written after every epoch (temporary name, then renamed); --resume continues from it
 and ends with the weights an uninterrupted run gives.
@@ -40,6 +40,8 @@ import time
 import numpy as np
 
 TASKS = ("COLL", "ALN", "OVR")
+ANCHORS = 5  # points the next command's position is chosen among (features' last columns)
+POSITION_SCALE, ROTATION_SCALE = 0.01, 0.05  # m, rad: a pose error of this size costs 1 in the loss
 MAX_OBJECTS = 2  # the objects of a task's goal roles (COLL: object, container; ALN, OVR: the object)
 
 
@@ -70,7 +72,8 @@ class SceneRoles:
         self.roles = [goal["object"]] + ([goal["container"]] if self.task == "COLL" else [])
         self.asset = scene["objects"][goal["object"]]["asset_id"]
         zero = (np.zeros(3), np.eye(3))
-        self.goal = pose_of_json(goal["goal_pose"]) if "goal_pose" in goal else zero
+        self.has_goal_pose = "goal_pose" in goal
+        self.goal = pose_of_json(goal["goal_pose"]) if self.has_goal_pose else zero
         self.obstacle = pose_of_json(scene["obstacles"][goal["obstacle"]]["pose"])[0] if "obstacle" in goal else np.zeros(3)
 
 
@@ -79,13 +82,24 @@ def six(r):
     return np.concatenate([r[..., :, 0], r[..., :, 1]], -1)
 
 
+def yaw(r):
+    """The heading of a rotation's x axis about world z."""
+    return np.arctan2(r[1, 0], r[0, 0])
+
+
+def turn(angle):
+    """An angle as cos, sin of itself and of twice and four times itself (a half and a quarter turn's
+    symmetries read the same)."""
+    return [np.cos(angle), np.sin(angle), np.cos(2 * angle), np.sin(2 * angle), np.cos(4 * angle), np.sin(4 * angle)]
+
+
 def features(roles, ee_position, ee_rotation, width, s, object_positions, object_rotations, memory, assets):
     """One row of inputs (see the module's comment). object_* are the scene's objects in its order;
     memory: the policy's previous command (7), the end effector's displacement since and the
     control steps since that command was first sent."""
-    previous, displacement, age = memory
+    previous, displacement, age, moves = memory
     parts = [ee_position, six(ee_rotation), [width * 10.0, s], previous[:3] - ee_position, previous[3:], displacement * 10.0,
-             [min(age, 720) / 360.0]]
+             [min(age, 720) / 360.0, min(moves, 8) / 4.0]]
     for k in range(MAX_OBJECTS):
         if k < len(roles.roles):
             p, r = object_positions[roles.roles[k]], object_rotations[roles.roles[k]]
@@ -93,12 +107,28 @@ def features(roles, ee_position, ee_rotation, width, s, object_positions, object
         else:
             parts += [np.zeros(3), np.zeros(3), np.zeros(6), [0.0]]
     goal_p, goal_r = roles.goal
-    moved = object_positions[roles.roles[0]]
+    moved, moved_r = object_positions[roles.roles[0]], object_rotations[roles.roles[0]]
     parts += [goal_p, goal_p - moved, six(goal_r), roles.obstacle, roles.obstacle - ee_position]
+    # headings: the turn the object still needs, and where the object's and the goal's point from the hand's
+    parts += [turn(yaw(goal_r) - yaw(moved_r)), turn(yaw(moved_r) - yaw(ee_rotation)), turn(yaw(goal_r) - yaw(ee_rotation))]
+    # where the end effector would be with the object at the goal pose, held as it is held now
+    # (ALN, OVR: the place's target while carrying; turned about z only, as the goal is upright)
+    at_goal = np.zeros(3)
+    if roles.has_goal_pose:
+        turned = yaw(goal_r) - yaw(moved_r)
+        cz, sz = np.cos(turned), np.sin(turned)
+        at_goal = goal_p + np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]]) @ (ee_position - moved)
+    parts += [at_goal - ee_position, at_goal - previous[:3]]
     one_hot = np.zeros(len(assets))
     if roles.asset in assets:
         one_hot[assets.index(roles.asset)] = 1.0
     parts.append(one_hot)
+    # the anchors of the next command's position, from the previous command's (the last ANCHORS x 3
+    # columns): itself, the moved object, the end effector at the goal, the goal or container, the
+    # end effector
+    anchor = object_positions[roles.roles[-1]] if roles.task == "COLL" else goal_p
+    for a in (previous[:3], moved, at_goal if roles.has_goal_pose else previous[:3], anchor, ee_position):
+        parts.append(a - previous[:3])
     return np.concatenate([np.asarray(p, dtype=np.float64).ravel() for p in parts])
 
 
@@ -133,8 +163,14 @@ def samples_of(episode, stride, repeat, assets):
     _, scene, a = episode
     roles = SceneRoles(scene)
     eef, grip, objects, target = a["eef_pose"], a["gripper"], a["object_poses"], a["ee_target"]
-    waypoint = a["ee_waypoint"][:, 0].astype(np.int64)
     steps = len(target)
+    # the commands: a new one wherever the target or S changes (obs/ee_waypoint counts pose changes only)
+    waypoint = np.concatenate([[0], np.cumsum(np.any(target[1:] != target[:-1], axis=1))])
+    # per command: how many commands since S last changed (0 for the one that changed it)
+    s_of = target[np.searchsorted(waypoint, np.arange(waypoint[-1] + 1)), 6]
+    moves = np.zeros(len(s_of), dtype=np.int64)
+    for w in range(1, len(s_of)):
+        moves[w] = 0 if s_of[w] != s_of[w - 1] else moves[w - 1] + 1
     first = np.searchsorted(waypoint, np.arange(waypoint[-1] + 2))  # first step of each waypoint (steps if none)
     k = objects.shape[1] // 7
     objects = objects.reshape(steps, k, 7)
@@ -146,20 +182,20 @@ def samples_of(episode, stride, repeat, assets):
             w = waypoint[t - repeat]
             previous, age, switch = target[t - repeat], t - first[w], waypoint[t] != w
             following = target[first[w + 1]] if first[w + 1] < steps else previous
-            before = t - repeat
+            before, count = t - repeat, moves[w] + 1
         else:  # the first command: the track holds the home pose
-            previous, age, switch, following, before = home_command(eef[0, :3]), t, True, target[0], 0
+            previous, age, switch, following, before, count = home_command(eef[0, :3]), t, True, target[0], 0, 0
         x = features(roles, eef[t, :3], ee_rot[t], grip[t, 0], grip[t, 1], objects[t, :, :3], obj_rot[t],
-                     (previous, eef[t, :3] - eef[before, :3], age), assets)
+                     (previous, eef[t, :3] - eef[before, :3], age, count), assets)
         xs.append(x)
-        ys.append(np.concatenate([following, [float(switch)]]))
+        ys.append(np.concatenate([following[:6] - previous[:6], following[6:], [float(switch)]]))
     return xs, ys
 
 
-def build_dataset(directory, task, stride, repeat):
-    episodes = read_episodes(directory, task)
+def build_dataset(directories, task, stride, repeat):
+    episodes = [e for d in directories for e in read_episodes(d, task)]
     if not episodes:
-        raise ValueError(f"{directory}: no {task} episodes")
+        raise ValueError(f"{', '.join(directories)}: no {task} episodes")
     assets = sorted({SceneRoles(e[1]).asset for e in episodes if e[0] == "train"})
     split = {"train": ([], []), "valid": ([], [])}
     for e in episodes:
@@ -174,18 +210,24 @@ def build_dataset(directory, task, stride, repeat):
 # ---- the model
 
 def build_model(torch, inputs, width=256, depth=3):
+    """The MLP: ANCHORS weights (logits), a position residual, a rotation vector change, S and the
+    switch (logits)."""
     layers, n = [], inputs
     for _ in range(depth):
         layers += [torch.nn.Linear(n, width), torch.nn.SiLU()]
         n = width
-    layers.append(torch.nn.Linear(n, 8))
+    layers.append(torch.nn.Linear(n, ANCHORS + 3 + 3 + 2))
     return torch.nn.Sequential(*layers)
 
 
 class Normaliser:
-    def __init__(self, x, y):
+    """The inputs' mean and spread over the training rows."""
+
+    def __init__(self, x):
         self.x_mean, self.x_std = x.mean(0), x.std(0) + 1e-6
-        self.y_mean, self.y_std = y[:, :6].mean(0), y[:, :6].std(0) + 1e-6
+
+    def __call__(self, x):
+        return (x - self.x_mean) / self.x_std
 
     def state(self):
         return {k: v.tolist() for k, v in vars(self).items()}
@@ -198,13 +240,23 @@ class Normaliser:
         return n
 
 
-def loss_of(torch, out, y, norm):
-    """Mean squared error of the next command's normalised pose, binary cross-entropy of its S and
-    of the switch."""
-    target = (y[:, :6] - torch.from_numpy(norm.y_mean)) / torch.from_numpy(norm.y_std)
-    pose = ((out[:, :6] - target) ** 2).mean()
+def decode(torch, out, x):
+    """The network's answer for raw inputs x: the next command's position and rotation vector as
+    changes from the previous command, the S logit and the switch logit. The position is the
+    softmax-weighted anchors plus a residual (an output of 1 is 10 cm)."""
+    anchors = x[:, -3 * ANCHORS:].reshape(-1, ANCHORS, 3)
+    weights = torch.softmax(out[:, :ANCHORS], 1)
+    position = (weights[:, :, None] * anchors).sum(1) + 0.1 * out[:, ANCHORS:ANCHORS + 3]
+    return position, out[:, ANCHORS + 3:ANCHORS + 6] * ROTATION_SCALE, out[:, -2], out[:, -1]
+
+
+def loss_of(torch, out, x, y):
+    """The pose errors in units of POSITION_SCALE and ROTATION_SCALE squared, the binary
+    cross-entropy of S and of the switch."""
+    position, rotation, s, switch = decode(torch, out, x)
+    pose = (((position - y[:, :3]) / POSITION_SCALE) ** 2).mean() + (((rotation - y[:, 3:6]) / ROTATION_SCALE) ** 2).mean()
     bce = torch.nn.functional.binary_cross_entropy_with_logits
-    return pose + bce(out[:, 6], (y[:, 6] >= 0.5).float()) + bce(out[:, 7], y[:, 7])
+    return pose + bce(s, (y[:, 6] >= 0.5).float()) + bce(switch, y[:, 7])
 
 
 def train_task(args, task, torch):
@@ -212,16 +264,15 @@ def train_task(args, task, torch):
     checkpoint = path + ".checkpoint"
     data, assets, counts = build_dataset(args.data, task, args.stride, args.repeat)
     x, y = data["train"]
-    norm = Normaliser(x, y)
-    xn = torch.from_numpy((x - norm.x_mean) / norm.x_std)
-    yt = torch.from_numpy(y)
+    norm = Normaliser(x)
+    xt, xn, yt = torch.from_numpy(x), torch.from_numpy(norm(x)), torch.from_numpy(y)
     valid = None
     if "valid" in data:
         vx, vy = data["valid"]
-        valid = (torch.from_numpy((vx - norm.x_mean) / norm.x_std), torch.from_numpy(vy))
+        valid = (torch.from_numpy(norm(vx)), torch.from_numpy(vx), torch.from_numpy(vy))
     torch.manual_seed(args.seed)
     model = build_model(torch, x.shape[1], args.width, args.depth)
-    optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
+    optimiser = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=args.weight_decay)
     epoch, history = 0, []
     generator = torch.Generator().manual_seed(args.seed)
     if args.resume and os.path.exists(checkpoint):
@@ -243,7 +294,7 @@ def train_task(args, task, torch):
         total = 0.0
         for start in range(0, len(order), args.batch):
             idx = order[start:start + args.batch]
-            loss = loss_of(torch, model(xn[idx]), yt[idx], norm)
+            loss = loss_of(torch, model(xn[idx]), xt[idx], yt[idx])
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
@@ -251,7 +302,7 @@ def train_task(args, task, torch):
         epoch += 1
         model.eval()
         with torch.no_grad():
-            held_out = loss_of(torch, model(valid[0]), valid[1], norm).item() if valid else None
+            held_out = loss_of(torch, model(valid[0]), valid[1], valid[2]).item() if valid else None
         history.append((epoch, total / len(xn), held_out))
         shown = "none (no valid episodes)" if held_out is None else f"{held_out:.4f}"
         print(f"{task} epoch {epoch}/{args.epochs}: train loss {total / len(xn):.4f}, held-out loss {shown}, "
@@ -298,7 +349,7 @@ class Policy:
 
     def reset(self):
         self.previous = self.position = None
-        self.age = 0
+        self.age = self.moves = 0
 
     def __call__(self, obs, roles):
         ee = np.asarray(obs["end_effector"])
@@ -307,13 +358,17 @@ class Policy:
             self.previous, self.position = home_command(p), p.copy()
         poses = np.asarray(obs["object_poses"])
         x = features(roles, p, r, float(obs["gripper_width"]), float(obs["gripper_state"]), poses[:, :3, 3], poses[:, :3, :3],
-                     (self.previous, p - self.position, self.age), self.assets)
-        with self.torch.no_grad():
-            out = self.model(self.torch.from_numpy(((x - self.norm.x_mean) / self.norm.x_std).astype(np.float32))[None])[0].numpy()
-        if out[7] > 0:
+                     (self.previous, p - self.position, self.age, self.moves), self.assets)
+        torch = self.torch
+        with torch.no_grad():
+            x = torch.from_numpy(x.astype(np.float32))[None]
+            position, rotation, s, switch = decode(torch, self.model(torch.from_numpy(self.norm(x.numpy()))), x)
+        if switch[0] > 0:
             action = np.empty(7)
-            action[:6] = out[:6] * self.norm.y_std + self.norm.y_mean
-            action[6] = 1.0 if out[6] > 0 else 0.0
+            action[:3] = self.previous[:3] + position[0].numpy()
+            action[3:6] = self.previous[3:6] + rotation[0].numpy()
+            action[6] = 1.0 if s[0] > 0 else 0.0
+            self.moves = 1 if action[6] != self.previous[6] else self.moves + 1
             self.previous, self.age = action, 0
         self.position = p.copy()
         self.age += self.repeat
@@ -351,12 +406,13 @@ def main(argv=None):
     p = argparse.ArgumentParser(description="The privileged-state reference policy on the end-effector track: train")
     sub = p.add_subparsers(dest="command", required=True)
     t = sub.add_parser("train", help="train one model per task on a generated dataset")
-    t.add_argument("--data", required=True, help="a dataset directory written by generate_dataset")
+    t.add_argument("--data", required=True, action="append", help="a dataset directory written by generate_dataset (repeat for more)")
     t.add_argument("--out", required=True, help="directory for <TASK>.pt")
     t.add_argument("--tasks", default="ALN,COLL")
     t.add_argument("--epochs", type=int, default=30)
     t.add_argument("--batch", type=int, default=512)
     t.add_argument("--lr", type=float, default=1e-3)
+    t.add_argument("--weight-decay", type=float, default=1e-4)
     t.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
     t.add_argument("--width", type=int, default=256)
     t.add_argument("--depth", type=int, default=3)

@@ -42,7 +42,7 @@ class ReferencePolicyTest(unittest.TestCase):
         self.assertEqual(len(losses), 20)
         self.assertLess(losses[-1], 0.5 * losses[0], losses)
         # the network as trained (the checkpoint's weights) and the model file read back by act()'s loader
-        data, assets, _ = rp.build_dataset(self.data, "ALN", 8, 36)
+        data, assets, _ = rp.build_dataset([self.data], "ALN", 8, 36)
         self.assertEqual(assets, saved["assets"])
         x = data["train"][0][:50]
         trained = rp.build_model(torch, x.shape[1], 64, 3)
