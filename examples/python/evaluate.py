@@ -569,6 +569,8 @@ def parse_args(argv):
         p.error("--episodes-per-category must be >= 1")
     if not args.policy_timeout > 0:
         p.error("--policy-timeout must be > 0")
+    if args.observation == "privileged" and not args.policy.startswith("python:"):
+        p.error(f"--observation privileged is for python: policies (--policy {args.policy} sees what it always sees)")
     for name in ("indices", "max_scan"):
         values = getattr(args, name)
         for v in values if isinstance(values, list) else [values]:

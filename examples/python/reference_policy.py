@@ -402,8 +402,34 @@ def act(obs):
     return _models[task](obs, _episode["roles"])
 
 
+def curves(args):
+    """The models' learning curves (train and held-out loss per epoch) in one picture."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import torch
+    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=120)
+    for path in args.models:
+        saved = torch.load(path)
+        epochs, train_loss, held_out = zip(*saved["history"])
+        line, = ax.plot(epochs, train_loss, label=f"{saved['task']} train")
+        if all(h is not None for h in held_out):
+            ax.plot(epochs, held_out, "--", color=line.get_color(), label=f"{saved['task']} held-out (valid mask)")
+    ax.set_xlabel("epoch")
+    ax.set_ylabel("loss (log scale)")
+    ax.set_yscale("log")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("Reference policy (privileged state, end-effector track): learning curves", fontsize=9)
+    fig.tight_layout()
+    tmp = args.out + ".tmp.png"
+    fig.savefig(tmp)
+    os.replace(tmp, args.out)
+    print(f"curves -> {args.out}")
+
+
 def main(argv=None):
-    p = argparse.ArgumentParser(description="The privileged-state reference policy on the end-effector track: train")
+    p = argparse.ArgumentParser(description="The privileged-state reference policy on the end-effector track: train, plot")
     sub = p.add_subparsers(dest="command", required=True)
     t = sub.add_parser("train", help="train one model per task on a generated dataset")
     t.add_argument("--data", required=True, action="append", help="a dataset directory written by generate_dataset (repeat for more)")
@@ -423,8 +449,11 @@ def main(argv=None):
     t.add_argument("--resume", action="store_true", help="continue from the checkpoint of a killed run")
     t.add_argument("--stop-after", type=int, default=None, help="stop after this many epochs of this run (a time-limited job), "
                    "leaving the checkpoint for --resume")
+    c = sub.add_parser("curves", help="plot the learning curves of trained models")
+    c.add_argument("models", nargs="+", help="<TASK>.pt files")
+    c.add_argument("--out", required=True, help="PNG file")
     args = p.parse_args(argv)
-    train(args)
+    (train if args.command == "train" else curves)(args)
     return 0
 
 

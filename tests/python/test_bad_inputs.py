@@ -114,6 +114,7 @@ class BadInputs(unittest.TestCase):
             for argv, words in [(["--policy", "python:no_such_module:act"], "no_such_module"), (["--jobs", "0"], "--jobs"),
                                 (["--indices", "3", "-1"], "--indices"), (["--chunk-steps", "0"], "--chunk-steps"),
                                 (["--action-mode", "joint"], "--action-mode"), (["--action-repeat", "0"], "--action-repeat"),
+                                (["--observation", "privileged"], "--observation privileged"),
                                 (["--out", os.path.join(a_file, "out")], "--out")]:
                 args = argv + ([] if "--out" in argv else ["--out", os.path.join(scratch, "out")])
                 done = subprocess.run([sys.executable, "-m", "evaluate", "--task", "COLL"] + args, capture_output=True, text=True, timeout=120)
