@@ -14,22 +14,24 @@ state and the episode's scene JSON, whose goal and assets a perfect perception w
 image and the instruction): the end-effector frame, the finger width and S, the task's objects in
 the goal's roles (the moved object first; COLL then the container), OVR's obstacle, the goal
 (ALN, OVR: the marker's pose), the moved object's asset, and the policy's own memory: its previous
-command, the end effector's displacement since its last call, the control steps since the command
-was first sent.
+command and that command's change from the one before, the end effector's displacement since its
+last call, the control steps since the command was first sent, the commands since S last changed.
 Action: the end-effector track's 7 floats (target position, rotation vector from the home
 orientation, S), sent every --action-repeat control steps (evaluate.py's default, 36: 20 Hz).
 Model: an MLP (3 x 256, SiLU) to two answers: whether to switch to a new command now (a logit),
-and the next command (position and rotation normalised by the training data's mean and spread,
-S as a logit). The policy keeps its previous command until the switch logit is positive, so the
-track is not restarted by the regression's small differences, and the next command is never an
-average of two waypoints: it is the one after the previous command's.
+and the next command: its position a softmax-weighted choice among anchors (the previous command,
+the moved object, the end effector at the goal, the goal or container, the end effector) plus a
+residual, its rotation vector a change from the previous command's, S a logit. The policy keeps
+its previous command until the switch logit is positive, so the track is not restarted by the
+regression's small differences, and the next command is never an average of two waypoints: it is
+the one after the previous command's.
 Training samples: every --stride-th control step t of the train mask's episodes, the previous
-command being the expert's target at t - --repeat (the control steps between commands); the
-switch label says whether the expert's command (target or S) changed since, the next command is
-the one after that one, as a change from it (position and rotation vector differences, S). Losses: mean squared error of the pose, binary
-cross-entropy of S and of the switch. The dataset's valid mask gives the held-out loss. A
-checkpoint is written after every epoch (temporary name, then renamed); --resume continues from it
-and ends with the weights an uninterrupted run gives.
+command being the expert's target at t - --repeat (the control steps between commands); a new
+command starts wherever the target or S changes; the switch label says whether the expert's
+command changed since, the next command is the one after that one. Losses: squared pose errors
+in units of 1 cm and 0.05 rad, binary cross-entropy of S and of the switch. The dataset's valid
+mask gives the held-out loss. A checkpoint is written after every epoch (temporary name, then
+renamed); --resume continues from it and ends with the weights an uninterrupted run gives.
 """
 import argparse
 import json
@@ -97,9 +99,9 @@ def features(roles, ee_position, ee_rotation, width, s, object_positions, object
     """One row of inputs (see the module's comment). object_* are the scene's objects in its order;
     memory: the policy's previous command (7), the end effector's displacement since and the
     control steps since that command was first sent."""
-    previous, displacement, age, moves = memory
-    parts = [ee_position, six(ee_rotation), [width * 10.0, s], previous[:3] - ee_position, previous[3:], displacement * 10.0,
-             [min(age, 720) / 360.0, min(moves, 8) / 4.0]]
+    previous, change, displacement, age, moves = memory
+    parts = [ee_position, six(ee_rotation), [width * 10.0, s], previous[:3] - ee_position, previous[3:], change * 10.0,
+             displacement * 10.0, [min(age, 720) / 360.0, min(moves, 8) / 4.0]]
     for k in range(MAX_OBJECTS):
         if k < len(roles.roles):
             p, r = object_positions[roles.roles[k]], object_rotations[roles.roles[k]]
@@ -183,10 +185,12 @@ def samples_of(episode, stride, repeat, assets):
             previous, age, switch = target[t - repeat], t - first[w], waypoint[t] != w
             following = target[first[w + 1]] if first[w + 1] < steps else previous
             before, count = t - repeat, moves[w] + 1
+            change = previous - (target[first[w - 1]] if w > 0 else home_command(eef[0, :3]))
         else:  # the first command: the track holds the home pose
             previous, age, switch, following, before, count = home_command(eef[0, :3]), t, True, target[0], 0, 0
+            change = np.zeros(7)
         x = features(roles, eef[t, :3], ee_rot[t], grip[t, 0], grip[t, 1], objects[t, :, :3], obj_rot[t],
-                     (previous, eef[t, :3] - eef[before, :3], age, count), assets)
+                     (previous, change, eef[t, :3] - eef[before, :3], age, count), assets)
         xs.append(x)
         ys.append(np.concatenate([following[:6] - previous[:6], following[6:], [float(switch)]]))
     return xs, ys
@@ -349,6 +353,7 @@ class Policy:
 
     def reset(self):
         self.previous = self.position = None
+        self.change = np.zeros(7)
         self.age = self.moves = 0
 
     def __call__(self, obs, roles):
@@ -358,7 +363,7 @@ class Policy:
             self.previous, self.position = home_command(p), p.copy()
         poses = np.asarray(obs["object_poses"])
         x = features(roles, p, r, float(obs["gripper_width"]), float(obs["gripper_state"]), poses[:, :3, 3], poses[:, :3, :3],
-                     (self.previous, p - self.position, self.age, self.moves), self.assets)
+                     (self.previous, self.change, p - self.position, self.age, self.moves), self.assets)
         torch = self.torch
         with torch.no_grad():
             x = torch.from_numpy(x.astype(np.float32))[None]
@@ -369,7 +374,7 @@ class Policy:
             action[3:6] = self.previous[3:6] + rotation[0].numpy()
             action[6] = 1.0 if s[0] > 0 else 0.0
             self.moves = 1 if action[6] != self.previous[6] else self.moves + 1
-            self.previous, self.age = action, 0
+            self.previous, self.change, self.age = action, action - self.previous, 0
         self.position = p.copy()
         self.age += self.repeat
         return self.previous.copy()
