@@ -97,8 +97,9 @@ def turn(angle):
 
 def features(roles, ee_position, ee_rotation, width, s, object_positions, object_rotations, memory, assets):
     """One row of inputs (see the module's comment). object_* are the scene's objects in its order;
-    memory: the policy's previous command (7), the end effector's displacement since and the
-    control steps since that command was first sent."""
+    memory: the policy's previous command (7), its change from the one before, the end effector's
+    displacement since the last call, the control steps since the command was first sent and the
+    commands since S last changed."""
     previous, change, displacement, age, moves = memory
     parts = [ee_position, six(ee_rotation), [width * 10.0, s], previous[:3] - ee_position, previous[3:], change * 10.0,
              displacement * 10.0, [min(age, 720) / 360.0, min(moves, 8) / 4.0]]
