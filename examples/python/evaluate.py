@@ -549,7 +549,7 @@ def parse_args(argv):
                         "(position, rotation vector) and S tracked by the model executor for --action-repeat control steps")
     p.add_argument("--action-repeat", type=int, default=36, help="control steps an ee_pose action is tracked (36: 20 Hz)")
     p.add_argument("--observation", default="image", choices=("image", "privileged"),
-                   help="what a python: or ws:// policy sees: the image and instruction, or the privileged state and the scene JSON")
+                   help="what a python: policy sees: the image and instruction, or the privileged state and the scene JSON")
     p.add_argument("--policy-timeout", type=float, default=60.0, help="seconds a policy call may take")
     p.add_argument("--image-size", type=int, nargs=2, default=[514, 514], metavar=("W", "H"))
     p.add_argument("--save-actions", action="store_true", help="write each episode's actions to OUT/actions/ (for replay:OUT)")
