@@ -153,16 +153,15 @@ def read_episodes(directory, task):
             if g.attrs["task"] != task:
                 continue
             mask = "train" if demo in masks["train"] else "valid"
-            names = ("eef_pose", "gripper", "object_poses", "ee_target", "ee_waypoint")
-            arrays = {k: g["obs"][k][()].astype(np.float64) for k in names}
+            arrays = {k: g["obs"][k][()].astype(np.float64) for k in ("eef_pose", "gripper", "object_poses", "ee_target")}
             out.append((mask, json.loads(g.attrs["scene"]), arrays))
     return out
 
 
 def samples_of(episode, stride, repeat, assets):
     """The episode's training rows at every stride-th step t: the inputs with the command sent at
-    t - repeat as the previous one; whether the expert's target changed since (the switch label);
-    the target of the waypoint after the previous command's (the next command)."""
+    t - repeat as the previous one; whether the expert's command changed since (the switch label);
+    the command after the previous one (the next command), as a change from it."""
     _, scene, a = episode
     roles = SceneRoles(scene)
     eef, grip, objects, target = a["eef_pose"], a["gripper"], a["object_poses"], a["ee_target"]
@@ -366,9 +365,9 @@ class Policy:
         x = features(roles, p, r, float(obs["gripper_width"]), float(obs["gripper_state"]), poses[:, :3, 3], poses[:, :3, :3],
                      (self.previous, self.change, p - self.position, self.age, self.moves), self.assets)
         torch = self.torch
+        x = x.astype(np.float32)[None]
         with torch.no_grad():
-            x = torch.from_numpy(x.astype(np.float32))[None]
-            position, rotation, s, switch = decode(torch, self.model(torch.from_numpy(self.norm(x.numpy()))), x)
+            position, rotation, s, switch = decode(torch, self.model(torch.from_numpy(self.norm(x))), torch.from_numpy(x))
         if switch[0] > 0:
             action = np.empty(7)
             action[:3] = self.previous[:3] + position[0].numpy()

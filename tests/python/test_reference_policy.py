@@ -9,7 +9,6 @@ import subprocess
 import tempfile
 import unittest
 
-import numpy as np
 import torch
 
 import evaluate
