@@ -32,6 +32,7 @@
 #include <utility>
 #include <vector>
 
+#include "manisoft/control/mlp_executor.hpp"
 #include "manisoft/control/model_executor.hpp"
 #include "manisoft/env/batched_reach_env.hpp"
 #include "manisoft/env/reach_env.hpp"
@@ -62,8 +63,9 @@ py::array_t<double> to_numpy(const Eigen::Ref<const Eigen::Matrix<double, Eigen:
   return out;
 }
 
-manisoft::env::ReachEnvConfig reach_config(const std::string& target_set, int horizon) {
+manisoft::env::ReachEnvConfig reach_config(const std::string& target_set, int horizon, double stability_beta = 1) {
   manisoft::env::ReachEnvConfig config;
+  config.stability.beta = stability_beta;
   config.target_set = manisoft::env::parse_target_set(target_set);
   if (horizon < 1) manisoft::detail::fail("horizon = ", horizon, " must be >= 1");
   config.horizon = horizon;
@@ -96,6 +98,37 @@ py::dict reach_observation_spec(const Env& env) {
   d["time"] = py::make_tuple(py::make_tuple(), "float64");
   return d;
 }
+
+/// control::MlpExecutor from Python: the action a weight file's network gives for a reach observation.
+class MlpExecutorHandle {
+ public:
+  MlpExecutorHandle(const std::string& path, int action_rows) : executor_(manisoft::control::MlpExecutor<double>::load(path, action_rows)) {}
+
+  /// observation: the reach environment's dict (target, end_effector 4 x 4; node_positions, node_velocities m x 3).
+  py::array_t<double> act(const py::dict& observation) {
+    manisoft::control::Observation<double> o;
+    o.target = manisoft_py::pose_of(observation["target"], "observation['target']");
+    o.end_effector = manisoft_py::pose_of(observation["end_effector"], "observation['end_effector']");
+    o.node_positions = nodes(observation, "node_positions");
+    o.node_velocities = nodes(observation, "node_velocities");
+    o.node_indices = Eigen::VectorXi::LinSpaced(o.node_positions.rows(), 0, int(o.node_positions.rows()) - 1);
+    Array3 action;
+    executor_.act(o, action);
+    return to_numpy(action);
+  }
+
+ private:
+  static Array3 nodes(const py::dict& observation, const char* key) {
+    const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(observation[key]);
+    if (!a || a.ndim() != 2 || a.shape(1) != 3) throw py::value_error(std::string("observation['") + key + "'] must be an m x 3 array");
+    Array3 out(a.shape(0), 3);
+    const auto v = a.unchecked<2>();
+    for (py::ssize_t r = 0; r < a.shape(0); ++r)
+      for (int c = 0; c < 3; ++c) out(r, c) = v(r, c);
+    return out;
+  }
+  manisoft::control::MlpExecutor<double> executor_;
+};
 
 class ReachEnvironment {
  public:
@@ -265,8 +298,8 @@ class BatchHandle {
 /// own buffers, kept alive by the object and overwritten by every reset and step.
 class ReachBatch : public BatchHandle<manisoft::env::BatchedReachEnv<>> {
  public:
-  ReachBatch(int num_envs, int threads, const std::string& target_set, int horizon)
-      : BatchHandle(num_envs, threads, reach_config(target_set, horizon), manisoft::rod::damping::AnalyticalLinear<double>(0.1)) {}
+  ReachBatch(int num_envs, int threads, const std::string& target_set, int horizon, double stability_beta)
+      : BatchHandle(num_envs, threads, reach_config(target_set, horizon, stability_beta), manisoft::rod::damping::AnalyticalLinear<double>(0.1)) {}
 
   /// The batch's arrays by name (views; the owner keeps the batch alive).
   static py::dict arrays(const py::object& owner) {
@@ -299,8 +332,9 @@ class ReachBatch : public BatchHandle<manisoft::env::BatchedReachEnv<>> {
 /// wraps it with Gymnasium's vector API (manisoft_vec.py). Its arrays are numpy views as ReachBatch's.
 class TaskBatch : public BatchHandle<manisoft::task::BatchedTaskEnv> {
  public:
-  TaskBatch(const std::string& task, const std::string& setting, const std::string& split, std::uint64_t seed, int num_envs, int threads)
-      : BatchHandle(num_envs, threads, settings(task, setting, split, seed)) {}
+  TaskBatch(const std::string& task, const std::string& setting, const std::string& split, std::uint64_t seed, int num_envs, int threads,
+            const std::string& action_mode, int action_repeat)
+      : BatchHandle(num_envs, threads, settings(task, setting, split, seed, action_mode, action_repeat)) {}
 
   static py::dict arrays(const py::object& owner) {
     const auto& b = owner.cast<const TaskBatch&>().batch_;
@@ -320,6 +354,7 @@ class TaskBatch : public BatchHandle<manisoft::task::BatchedTaskEnv> {
     d["steps"] = batch_view(b.steps(), {n}, owner);
     d["failure"] = batch_view(b.failure(), {n}, owner);
     d["indices"] = batch_view(b.indices(), {n}, owner);
+    d["control_steps"] = batch_view(b.control_steps(), {n}, owner);
     return d;
   }
 
@@ -340,13 +375,26 @@ class TaskBatch : public BatchHandle<manisoft::task::BatchedTaskEnv> {
     return out;
   }
 
+  /// Each arm's end-effector command of the last step (as the single environment's info["ee_command"]).
+  py::tuple ee_commands() const {
+    py::tuple out(batch_.batch_size());
+    const auto c = batch_.ee_command();
+    for (int i = 0; i < batch_.batch_size(); ++i) out[i] = std::string(manisoft::task::to_string(static_cast<manisoft::task::EeCommand>(c[std::size_t(i)])));
+    return out;
+  }
+
   int n_elements() const { return batch_.n_elements(); }
   int max_objects() const { return batch_.max_objects(); }
-  py::dict action_space() const { return manisoft_py::task_action_spec(batch_.n_elements()); }
+  bool ee_pose() const { return batch_.settings().ee_track.has_value(); }
+  py::dict action_space() const { return ee_pose() ? manisoft_py::ee_action_spec() : manisoft_py::task_action_spec(batch_.n_elements()); }
 
  private:
-  static manisoft::task::BatchedTaskEnv::Settings settings(const std::string& task, const std::string& setting, const std::string& split, std::uint64_t seed) {
+  static manisoft::task::BatchedTaskEnv::Settings settings(const std::string& task, const std::string& setting, const std::string& split, std::uint64_t seed,
+                                                          const std::string& action_mode, int action_repeat) {
     manisoft::task::BatchedTaskEnv::Settings s;
+    if (action_mode != "torque" && action_mode != "ee_pose")
+      throw py::value_error("make_vec_env: action_mode = '" + action_mode + "' must be 'torque' or 'ee_pose'");
+    if (action_mode == "ee_pose") s.ee_track = manisoft_py::ee_track_config(action_repeat);
     s.task = manisoft::scene::parse_task(task);
     s.setting = manisoft::scene::parse_setting(setting);
     s.split = manisoft::scene::parse_split(split);
@@ -411,8 +459,12 @@ PYBIND11_MODULE(_manisoft, m) {
       .def("_action_space_spec", &ReachEnvironment::action_space)            // manisoft_vec.py makes the spaces of these
       .def("_observation_space_spec", &ReachEnvironment::observation_space)
       .def_property_readonly("horizon", &ReachEnvironment::horizon);
+  py::class_<MlpExecutorHandle>(m, "MlpExecutor", "An MLP executor's weight file (control/mlp_executor.hpp) acting on reach observations")
+      .def(py::init<const std::string&, int>(), py::arg("path"), py::arg("action_rows") = manisoft::env::ReachEnvConfig{}.rod.n_elements)
+      .def("act", &MlpExecutorHandle::act, py::arg("observation"), "The action (rows x 3 element torques, unclamped) for a reach observation");
   py::class_<ReachBatch>(m, "_ReachBatch", "B reach environments stepped together (use manisoft.make_vec_env)")
-      .def(py::init<int, int, const std::string&, int>(), py::arg("num_envs"), py::arg("threads"), py::arg("target_set"), py::arg("horizon"))
+      .def(py::init<int, int, const std::string&, int, double>(), py::arg("num_envs"), py::arg("threads"), py::arg("target_set"), py::arg("horizon"),
+           py::arg("stability_beta"))
       .def("reset", &ReachBatch::reset, py::arg("seeds"), py::arg("mask") = py::none())
       .def("step", &ReachBatch::step, py::arg("actions"))
       .def("arrays", [](const py::object& self) { return ReachBatch::arrays(self); })
@@ -422,13 +474,14 @@ PYBIND11_MODULE(_manisoft, m) {
       .def("_action_space_spec", &ReachBatch::action_space)
       .def("_observation_space_spec", &ReachBatch::observation_space);
   py::class_<TaskBatch>(m, "_TaskBatch", "B task environments stepped together (use manisoft.make_vec_env)")
-      .def(py::init<const std::string&, const std::string&, const std::string&, std::uint64_t, int, int>(), py::arg("task"), py::arg("setting"),
-           py::arg("split"), py::arg("seed"), py::arg("num_envs"), py::arg("threads"))
+      .def(py::init<const std::string&, const std::string&, const std::string&, std::uint64_t, int, int, const std::string&, int>(), py::arg("task"),
+           py::arg("setting"), py::arg("split"), py::arg("seed"), py::arg("num_envs"), py::arg("threads"), py::arg("action_mode"), py::arg("action_repeat"))
       .def("reset", &TaskBatch::reset, py::arg("indices"), py::arg("mask") = py::none())
       .def("step", &TaskBatch::step, py::arg("actions"))
       .def("arrays", [](const py::object& self) { return TaskBatch::arrays(self); })
       .def("instructions", &TaskBatch::instructions)
       .def("failures", &TaskBatch::failures)
+      .def("ee_commands", &TaskBatch::ee_commands)
       .def_property_readonly("num_envs", &TaskBatch::num_envs)
       .def_property_readonly("threads", &TaskBatch::threads)
       .def_property_readonly("n_elements", &TaskBatch::n_elements)
@@ -504,6 +557,7 @@ PYBIND11_MODULE(_manisoft, m) {
       "The benchmark's tasks in order: [{'name', 'summary', 'conditions', 'by_category'}] (success: every condition holds; "
       "by_category: evaluation plans and tables per target-object category)");
   m.attr("HORIZON") = task_horizon;
+  m.attr("ACTION_REPEAT") = manisoft::task::EeTrackConfig{}.action_repeat;  ///< the end-effector track's default control steps a step
   manisoft_py::add_python_side(m);
   m.attr("CONTROL_DT") = manisoft::task::TaskEnvConfig{}.dt * manisoft::task::TaskEnvConfig{}.substeps;
   m.def(

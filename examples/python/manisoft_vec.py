@@ -391,6 +391,7 @@ class ReachVectorEnv(_VectorEnv):
     for that arm is ignored, returning the new episode's first observation, reward 0 and flags
     False. The new episode's seed is the ended one's + num_envs.
 
+    Rewards: R_d + R_s of the paper (reach_env.hpp); stability_beta is R_s's beta (0: R_d alone).
     Observations: dict of end_effector, target (B x 4 x 4), node_positions, node_velocities
     (B x m x 3). Infos: dict of arrays of leading dimension B: success, steps, position_error,
     rotation_error, clipped, max_node_speed, seed, each with Gymnasium's mask "_key" (a bool array
@@ -404,10 +405,10 @@ class ReachVectorEnv(_VectorEnv):
     _INFOS = ("success", "steps", "position_error", "rotation_error", "clipped", "max_node_speed")
     _ACTION_LAYOUT = "(num_envs, rows, 3)"
 
-    def __init__(self, num_envs, num_threads=None, target_set="table", seed=0, horizon=None):
+    def __init__(self, num_envs, num_threads=None, target_set="table", seed=0, horizon=None, stability_beta=1.0):
         num_envs, num_threads = _checked_counts(num_envs, num_threads)
         horizon = HORIZON if horizon is None else horizon  # noqa: F821 (compiled constant)
-        batch = _ReachBatch(num_envs, num_threads, target_set, int(horizon))  # noqa: F821
+        batch = _ReachBatch(num_envs, num_threads, target_set, int(horizon), float(stability_beta))  # noqa: F821
         self.horizon = int(horizon)
         self.single_action_space, self.single_observation_space = _spaces_of(batch)
         del self.single_observation_space.spaces["time"]  # the batch observes no time (infos["steps"] * CONTROL_DT)
@@ -430,26 +431,33 @@ class TaskVectorEnv(_VectorEnv):
     an arm); reset() continues each arm's indices (its current one + num_envs; the first reset:
     make_vec_env's first_index + i). options={"reset_mask": ...} as the reach batch's.
     step(actions): num_envs x (3n + 1) flat actions (torques, then S; the single environment's
-    layout). Autoreset NEXT_STEP: an ended arm (terminated: success or a terminal failure;
+    layout), one control step. action_mode="ee_pose": num_envs x 7 end-effector actions (target
+    position, rotation vector from the home orientation, S: make_env's ee_pose layout), each arm's
+    target tracked by its own model executor for action_repeat control steps (fewer when its
+    episode ends; infos["control_steps"]), as make_env(..., action_mode="ee_pose") does; infos
+    ["ee_command"] says what each command did ("line", "ramp", "kept", "refused"). Autoreset NEXT_STEP: an ended arm (terminated: success or a terminal failure;
     truncated: the horizon T) starts its next scene (index + num_envs) at the next step, whose
     action for it is ignored.
     Observations: rod_nodes (B x (n + 1) x 3), end_effector, gripper_pose (B x 4 x 4),
     gripper_width (B), gripper_state (B), object_poses (B x K x 4 x 4: the first object_count[i]
     are arm i's objects, the others zero), object_count (B), instruction (a tuple of B str).
-    Infos: success, steps, failure (the task layer's reason: None or a name, a tuple of B), seed
-    (each arm's scene index), with Gymnasium's "_key" masks. Arrays are read-only views of the
+    Infos: success, steps, control_steps (the step's), failure (the task layer's reason: None or a
+    name, a tuple of B), seed (each arm's scene index), with Gymnasium's "_key" masks. Arrays are read-only views of the
     batch's buffers, overwritten by the next reset or step (copy what you keep).
     """
 
     _OBSERVATIONS = ("rod_nodes", "end_effector", "gripper_pose", "gripper_width", "gripper_state", "object_poses", "object_count")
-    _INFOS = ("success", "steps")
+    _INFOS = ("success", "steps", "control_steps")
     _EPISODE = "indices"
-    _ACTION_LAYOUT = "(num_envs, 3n + 1)"
 
-    def __init__(self, task, num_envs, num_threads=None, setting="clean", split="train", seed=0, first_index=0):
+    def __init__(self, task, num_envs, num_threads=None, setting="clean", split="train", seed=0, first_index=0,
+                 action_mode="torque", action_repeat=None):
         num_envs, num_threads = _checked_counts(num_envs, num_threads)
-        self.task, self.setting, self.split = task, setting, split
-        batch = _TaskBatch(task, setting, split, _count(seed, "make_vec_env: seed"), num_envs, num_threads)  # noqa: F821
+        self.task, self.setting, self.split, self.action_mode = task, setting, split, action_mode
+        self.action_repeat = 1 if action_mode == "torque" else (ACTION_REPEAT if action_repeat is None else int(action_repeat))  # noqa: F821
+        self._ACTION_LAYOUT = "(num_envs, 7)" if action_mode == "ee_pose" else "(num_envs, 3n + 1)"
+        batch = _TaskBatch(task, setting, split, _count(seed, "make_vec_env: seed"), num_envs, num_threads, action_mode,  # noqa: F821
+                           self.action_repeat)
         self.horizon = HORIZON  # noqa: F821 (compiled constant)
         self.single_action_space, _ = _spaces_of(batch)
         n, k = batch.n_elements, batch.max_objects
@@ -472,10 +480,14 @@ class TaskVectorEnv(_VectorEnv):
         infos = super()._infos()
         infos["failure"] = self._batch.failures()
         infos["_failure"] = self._every_arm
+        if self.action_mode == "ee_pose":
+            infos["ee_command"] = self._batch.ee_commands()
+            infos["_ee_command"] = self._every_arm
         return infos
 
     def __repr__(self):
-        return f"TaskVectorEnv({self.task!r}, num_envs={self.num_envs}, num_threads={self.num_threads}, setting={self.setting!r})"
+        return (f"TaskVectorEnv({self.task!r}, num_envs={self.num_envs}, num_threads={self.num_threads}, setting={self.setting!r}, "
+                f"action_mode={self.action_mode!r})")
 
 
 def _count(value, what):
@@ -488,9 +500,10 @@ def make_vec_env(name, num_envs, num_threads=None, **kwargs):
     """num_envs environments stepped together by one call over num_threads threads (default: the
     machine's cores), Gymnasium 1.x VectorEnv API, NEXT_STEP autoreset:
       make_vec_env("reach", num_envs, num_threads=None, target_set="table"|"equilibria", seed=0,
-                    horizon=HORIZON) -> ReachVectorEnv
+                    horizon=HORIZON, stability_beta=1.0) -> ReachVectorEnv
       make_vec_env(task, num_envs, num_threads=None, setting="clean", split="train", seed=0,
-                    first_index=0) -> TaskVectorEnv (a task of manisoft.tasks(): the state track)"""
+                    first_index=0, action_mode="torque"|"ee_pose", action_repeat=36) -> TaskVectorEnv
+                    (a task of manisoft.tasks(), privileged state observations)"""
     if name == "reach":
         return ReachVectorEnv(num_envs, num_threads, **kwargs)
     names = [t["name"] for t in tasks()]  # noqa: F821 (compiled function)

@@ -6,6 +6,7 @@
 
 The compiled part is manisoft._manisoft; everything public in it is here. The package's scripts
 run as modules: python3 -m manisoft.evaluate (the evaluation harness), manisoft.read_dataset,
-manisoft.export_zarr, manisoft.dataset_stats, manisoft.bc_baseline and manisoft.reference_policy.
+manisoft.export_zarr, manisoft.dataset_stats, manisoft.bc_baseline, manisoft.reference_policy and
+manisoft.sac_executor (the SAC-trained executor).
 """
 from ._manisoft import *  # noqa: F401,F403

@@ -268,6 +268,14 @@ inline py::array_t<double> ee_action_of(const ms::task::TaskEnv& env, const ms::
   return out;
 }
 
+/// The end-effector track's settings with `action_repeat` control steps a command.
+inline ms::task::EeTrackConfig ee_track_config(int action_repeat) {
+  ms::task::EeTrackConfig c;
+  if (action_repeat < 1) throw py::value_error("action_repeat = " + std::to_string(action_repeat) + " must be at least 1");
+  c.action_repeat = action_repeat;
+  return c;
+}
+
 class TaskEnvironment {
  public:
   using Array3 = ms::task::TaskEnv::Array3;
@@ -275,7 +283,7 @@ class TaskEnvironment {
 
   TaskEnvironment(const std::string& task, const std::string& setting, std::uint64_t seed, bool render, const std::optional<py::dict>& camera,
                   bool privileged, const std::string& split, const std::string& action_mode, int action_repeat)
-      : env_(sampler_.library()), expert_(env_), track_(env_, track_config(action_repeat)), seed_(seed), render_(render), privileged_(privileged) {
+      : env_(sampler_.library()), expert_(env_), track_(env_, ee_track_config(action_repeat)), seed_(seed), render_(render), privileged_(privileged) {
     if (action_mode != "torque" && action_mode != "ee_pose")
       throw py::value_error("make_env: action_mode = '" + action_mode + "' must be 'torque' or 'ee_pose'");
     ee_mode_ = action_mode == "ee_pose";
@@ -465,13 +473,6 @@ class TaskEnvironment {
       if (!std::isfinite(v(i)))
         throw py::value_error("step: action entry " + std::to_string(i) + " (" + describe(static_cast<int>(i)) + ") is not finite");
     return values;
-  }
-
-  static ms::task::EeTrackConfig track_config(int action_repeat) {
-    ms::task::EeTrackConfig c;
-    if (action_repeat < 1) throw py::value_error("make_env: action_repeat = " + std::to_string(action_repeat) + " must be at least 1");
-    c.action_repeat = action_repeat;
-    return c;
   }
 
   /// One "ee_pose" action: the target commanded, then action_repeat control steps (fewer when the

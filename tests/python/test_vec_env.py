@@ -1,8 +1,8 @@
 """The vector environments (manisoft.make_vec_env) against single environments: each reach arm
 bit-identical to make_env("reach") with the same seeds and actions at 1 and 2 threads, reset
 masks, Gymnasium's NEXT_STEP autoreset, bad actions refused with nothing changed; each task arm
-bit-identical to make_env(task, render=False, privileged=True) on the same scene, autoreset at the
-horizon; and the spaces' sample / contains.
+bit-identical to make_env(task, render=False, privileged=True) on the same scene, on the torque
+and the end-effector tracks, autoreset at the horizon; and the spaces' sample / contains.
 Run: PYTHONPATH=<build>/python python3 -m unittest test_vec_env."""
 import unittest
 
@@ -319,6 +319,44 @@ class TaskVecAgainstSingle(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "unknown environment 'PICK'"):
             manisoft.make_vec_env("PICK", 2)
         vec.close()
+
+    def test_end_effector_track_against_singles(self):
+        """action_mode="ee_pose": arm i against make_env(task, action_mode="ee_pose") on the same scene
+        and targets (around the home pose, closing the gripper after 10 commands), two threads, with
+        the commands' outcomes and control steps; a bad entry is refused by name."""
+        vec = manisoft.make_vec_env("COLL", B, num_threads=2, seed=0, action_mode="ee_pose", action_repeat=12)
+        self.assertEqual((vec.single_action_space.shape, vec.action_space.shape, vec.action_repeat), ((7,), (B, 7), 12))
+        obs, info = vec.reset(seed=7)
+        singles = [manisoft.make_env("COLL", "clean", seed=0, render=False, privileged=True, action_mode="ee_pose", action_repeat=12)
+                   for _ in range(B)]
+        home = np.array(obs["end_effector"][:, :3, 3])
+        for i, env in enumerate(singles):
+            s_obs, s_info = env.reset(options={"index": 7 + i})
+            self.assert_arm_equals((obs, np.zeros(B), np.zeros(B, bool), np.zeros(B, bool), info), i, (s_obs, 0.0, False, False, s_info))
+        bad = np.zeros((B, 7))
+        bad[2, 4] = np.inf
+        with self.assertRaisesRegex(ValueError, r"arm 2: action entry 4 \(ry\) = inf is not finite"):
+            vec.step(bad)
+        rng = np.random.default_rng(3)
+        commands = set()
+        for k in range(25):
+            a = np.zeros((B, 7))
+            a[:, :3] = home + rng.normal(scale=0.05, size=(B, 3)) - [0, 0, 0.004 * k]
+            a[:, 3:6] = rng.normal(scale=0.1, size=(B, 3))
+            a[:, 6] = k >= 10
+            result = vec.step(a)
+            for i, env in enumerate(singles):
+                single = env.step(a[i])
+                self.assert_arm_equals(result, i, single)
+                self.assertEqual((result[4]["ee_command"][i], result[4]["control_steps"][i]),
+                                 (single[4]["ee_command"], single[4]["control_steps"]))
+                commands.add(single[4]["ee_command"])
+        self.assertIn("line", commands)
+        np.testing.assert_array_equal(result[0]["gripper_state"], 1)
+        with self.assertRaisesRegex(ValueError, "action_mode = 'joint' must be 'torque' or 'ee_pose'"):
+            manisoft.make_vec_env("COLL", 1, action_mode="joint")
+        vec.close()
+
 
 if __name__ == "__main__":
     unittest.main()

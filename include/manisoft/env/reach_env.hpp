@@ -17,7 +17,7 @@
 // Observation: target, end-effector pose (the gripper's attachment frame: centre of the palm's
 // top face), positions and velocities of every `observe_stride`-th node (always the tip).
 // Reward: R = R_d + R_s of the paper (d = |d_p| + 0.2 |d_r|; k1 = 0.5, k2 = 1.5, d1 = 0.1,
-// d2 = 0.05; beta = 1, D = 0.3). Success: within tolerance, then held for `hold_steps` control
+// d2 = 0.05; beta = 1, D = 0.3 by default: config.stability). Success: within tolerance, then held for `hold_steps` control
 // steps (first_success_step is the first step of that held window). A diverged simulation step
 // ends the episode (info.diverged; the world keeps its state before the step); invalid input
 // (a malformed action) is refused with manisoft::InvalidInput and changes nothing.
@@ -88,6 +88,7 @@ struct ReachEnvConfig {
   double tolerance_rotation = 0.3;          ///< rad, on |d_r|
   int hold_steps = 100;                     ///< control steps the tolerance must hold
   int stability_window = 1000;              ///< simulation steps of the stability variance
+  reward::StabilityRewardParameters<double> stability{};  ///< R_s (beta = 0: R_d alone)
 };
 
 struct ReachInfo {
@@ -138,6 +139,7 @@ class ReachEnv {
     manisoft::detail::require_positive("tolerance_rotation", config_.tolerance_rotation);
     if (config_.hold_steps < 1) manisoft::detail::fail("hold_steps = ", config_.hold_steps, " must be >= 1");
     if (config_.stability_window < 1) manisoft::detail::fail("stability_window = ", config_.stability_window, " must be >= 1");
+    reward_ = Reward(reward::DistanceReward<double>{}, reward::StabilityReward<double>(config_.stability));  // checks the parameters
     const int n = config_.rod.n_elements;
     observation_ = control::make_arm_observation<double>(n, config_.observe_stride);
     d_history_.setZero(config_.stability_window);
@@ -166,7 +168,7 @@ class ReachEnv {
     settings.limits = config_.limits;
     settings.substeps_per_control_step = config_.substeps;
     world_.emplace(Rod(sim, config_.dt, damping_), settings);
-    reward_ = Reward{};
+    reward_ = Reward(reward::DistanceReward<double>{}, reward::StabilityReward<double>(config_.stability));
     info_ = ReachInfo{};
     held_ = 0;
     d_count_ = 0;

@@ -8,6 +8,13 @@
 //   batch.step(actions);                      // B flat actions of 3n + 1 (control/action_layout.hpp)
 //   batch.rewards()[i], batch.terminated()[i], batch.object_poses() ...
 //
+// Tracks. The torque track (the default): an arm's action is its n x 3 element torques and S, one
+// control step a step(). The end-effector track (Settings::ee_track set, task/ee_track.hpp): an
+// arm's action is 7 values, the target position, the rotation vector from the home orientation and
+// S (task::ee_action's layout; S >= 0.5 closes), commanded to the arm's own EndEffectorTrack, which
+// then runs ee_track->action_repeat control steps (fewer when the episode ends) in one step();
+// ee_command and control_steps say what the command did and how many control steps it ran.
+//
 // Layout. Every array is owned by the batch, contiguous, row-major with the arm as its leading
 // dimension, allocated once and overwritten by every reset and step:
 //   rod_nodes        B x (n + 1) x 3   m, lab frame
@@ -25,6 +32,8 @@
 //   steps            B                 control steps of the current episode
 //   failure          B                 FailureReason as an integer (0: none)
 //   indices          B                 the scene index of each arm's current episode
+//   ee_command       B                 the end-effector track's EeCommand of the step (0 on the torque track)
+//   control_steps    B                 control steps the step ran (0 at a reset)
 // Flags are std::uint8_t 0 / 1. The instruction of arm i's scene is instruction(i).
 //
 // Autoreset (Gymnasium 1.x NEXT_STEP): an arm whose episode ended in one step() is reset by the
@@ -46,6 +55,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -54,6 +64,7 @@
 #include "manisoft/core/error.hpp"
 #include "manisoft/core/worker_pool.hpp"
 #include "manisoft/scene/scene_sampler.hpp"
+#include "manisoft/task/ee_track.hpp"
 #include "manisoft/task/task_env.hpp"
 
 namespace manisoft::task {
@@ -67,6 +78,7 @@ class BatchedTaskEnv {
     std::uint64_t seed = 0;  ///< the dataset seed of every scene draw
     int max_objects = 16;    ///< K of object_poses (a scene with more objects is refused, naming it)
     TaskEnvConfig env;
+    std::optional<EeTrackConfig> ee_track;  ///< set: the end-effector track (actions of 7), else torques
   };
   using Action = control::FlatAction;
 
@@ -75,10 +87,14 @@ class BatchedTaskEnv {
     if (settings_.max_objects < 1) manisoft::detail::fail("BatchedTaskEnv: max_objects = ", settings_.max_objects, " must be >= 1");
     samplers_.resize(std::size_t(pool_.threads()));
     arms_.resize(std::size_t(batch_size));
+    tracks_.resize(std::size_t(batch_size));
     specs_.resize(std::size_t(batch_size));
     // every worker's sampler loads the asset library; the arms read the first one's
     for_each_part([&](int part) { samplers_[std::size_t(part)] = std::make_unique<scene::SceneSampler>(); });
-    for_each_arm([&](int, std::size_t i) { arms_[i] = std::make_unique<TaskEnv>(samplers_[0]->library(), settings_.env); });
+    for_each_arm([&](int, std::size_t i) {
+      arms_[i] = std::make_unique<TaskEnv>(samplers_[0]->library(), settings_.env);
+      if (settings_.ee_track) tracks_[i] = std::make_unique<EndEffectorTrack>(*arms_[i], *settings_.ee_track);
+    });
     n_ = arms_[0]->arm_model().rod.n_elements;
     torques_.assign(std::size_t(batch_size), TaskEnv::Array3::Zero(n_, 3));
     allocate(std::size_t(batch_size));
@@ -87,8 +103,8 @@ class BatchedTaskEnv {
   int batch_size() const { return int(arms_.size()); }
   int threads() const { return pool_.threads(); }
   int n_elements() const { return n_; }
-  /// Entries of one arm's flat action (3n + 1).
-  int action_size() const { return Action::size(n_); }
+  /// Entries of one arm's action: 3n + 1 on the torque track, 7 on the end-effector track.
+  int action_size() const { return settings_.ee_track ? int(EeAction::RowsAtCompileTime) : Action::size(n_); }
   int max_objects() const { return settings_.max_objects; }
   const Settings& settings() const { return settings_; }
   /// Arm i's environment (its scene, world, conditions).
@@ -118,13 +134,14 @@ class BatchedTaskEnv {
     if (!started_) manisoft::detail::fail("BatchedTaskEnv::step called before reset");
     const std::size_t per_arm = std::size_t(action_size());
     if (actions.size() != arms_.size() * per_arm)
-      manisoft::detail::fail("BatchedTaskEnv::step: actions hold ", actions.size(), " values, expected batch_size x (3n + 1) = ",
-                             arms_.size(), " x ", per_arm, " = ", arms_.size() * per_arm);
+      manisoft::detail::fail("BatchedTaskEnv::step: actions hold ", actions.size(), " values, expected batch_size x ",
+                             settings_.ee_track ? "7" : "(3n + 1)", " = ", arms_.size(), " x ", per_arm, " = ", arms_.size() * per_arm);
     for (std::size_t i = 0; i < arms_.size(); ++i) {
       if (pending_reset_[i]) continue;
       for (std::size_t k = 0; k < per_arm; ++k)
         if (!std::isfinite(actions[i * per_arm + k]))
-          manisoft::detail::fail("BatchedTaskEnv::step: arm ", i, ": action entry ", k, " (", Action::describe(int(k), n_), ") = ",
+          manisoft::detail::fail("BatchedTaskEnv::step: arm ", i, ": action entry ", k, " (",
+                                 settings_.ee_track ? std::string(ee_entry_names[k]) : Action::describe(int(k), n_), ") = ",
                                  actions[i * per_arm + k], " is not finite");
     }
     for_each_arm([this, actions](int part, std::size_t i) { step_arm(part, i, actions); });
@@ -144,8 +161,12 @@ class BatchedTaskEnv {
   std::span<const std::int32_t> steps() const { return steps_; }
   std::span<const std::int32_t> failure() const { return failure_; }
   std::span<const std::uint64_t> indices() const { return indices_; }
+  std::span<const std::int32_t> ee_command() const { return ee_command_; }
+  std::span<const std::int32_t> control_steps() const { return control_steps_; }
 
  private:
+  static constexpr const char* ee_entry_names[7] = {"x", "y", "z", "rx", "ry", "rz", "S"};
+
   void allocate(std::size_t b) {
     rod_nodes_.assign(b * std::size_t(n_ + 1) * 3, 0.0);
     end_effector_.assign(b * 16, 0.0);
@@ -163,6 +184,8 @@ class BatchedTaskEnv {
     steps_.assign(b, 0);
     failure_.assign(b, 0);
     indices_.assign(b, 0);
+    ee_command_.assign(b, 0);
+    control_steps_.assign(b, 0);
   }
 
   void require_size(const char* what, std::size_t size) const {
@@ -207,7 +230,9 @@ class BatchedTaskEnv {
       manisoft::detail::fail("BatchedTaskEnv: scene ", index, " has ", specs_[i].objects.size(), " objects, more than max_objects = ",
                              settings_.max_objects);
     arms_[i]->reset(specs_[i]);
+    if (tracks_[i]) tracks_[i]->reset();
     indices_[i] = index;
+    ee_command_[i] = control_steps_[i] = 0;
     write(i);
     pending_reset_[i] = terminated_[i];  // a scene that is no task (scene_invalid) is replaced at the next step
   }
@@ -218,8 +243,21 @@ class BatchedTaskEnv {
       return;
     }
     const double* a = actions.data() + i * std::size_t(action_size());
-    const int s = Action::unpack([a](int k) { return a[k]; }, torques_[i]);
-    arms_[i]->step(torques_[i], s);
+    if (tracks_[i]) {
+      const EeAction ee = Eigen::Map<const EeAction>(a);
+      const int s = ee(6) >= 0.5 ? 1 : 0;
+      ee_command_[i] = std::int32_t(tracks_[i]->command(ee_target_of(ee, arms_[i]->home_pose().rotation)));
+      int taken = 0;
+      for (; taken < tracks_[i]->config().action_repeat && !arms_[i]->done(); ++taken) {
+        tracks_[i]->act(torques_[i]);
+        arms_[i]->step(torques_[i], s);
+      }
+      control_steps_[i] = taken;
+    } else {
+      const int s = Action::unpack([a](int k) { return a[k]; }, torques_[i]);
+      arms_[i]->step(torques_[i], s);
+      control_steps_[i] = 1;
+    }
     write(i);
     pending_reset_[i] = terminated_[i] || truncated_[i];
   }
@@ -264,6 +302,7 @@ class BatchedTaskEnv {
   WorkerPool pool_;
   std::vector<std::unique_ptr<scene::SceneSampler>> samplers_;
   std::vector<std::unique_ptr<TaskEnv>> arms_;
+  std::vector<std::unique_ptr<EndEffectorTrack>> tracks_;  ///< the end-effector track's, else null
   std::vector<scene::SceneSpec> specs_;
   std::vector<TaskEnv::Array3> torques_;
   int n_ = 0;
@@ -271,7 +310,7 @@ class BatchedTaskEnv {
   std::vector<double> rod_nodes_, end_effector_, gripper_pose_, gripper_width_, object_poses_, rewards_;
   std::vector<std::uint8_t> terminated_, truncated_, success_, pending_reset_, do_reset_;
   std::vector<std::int64_t> gripper_state_, object_count_;
-  std::vector<std::int32_t> steps_, failure_;
+  std::vector<std::int32_t> steps_, failure_, ee_command_, control_steps_;
   std::vector<std::uint64_t> indices_;
 };
 
