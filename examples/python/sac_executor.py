@@ -295,8 +295,9 @@ def train(args):
         if round_ == 0 and not args.init:  # the fixed input normalisation, from the first round's states under random actions
             sample = []
         stats = {"reward": 0.0, "diverged": 0, "critic": 0.0, "actor": 0.0}
+        credit = 0.0
         for _ in range(decisions):
-            if replay.size < args.warmup and not args.init:
+            if (replay.size < args.warmup or round_ == 0) and not args.init:
                 u = explore.uniform(-1, 1, (args.envs, act_size)).astype(np.float32)
             else:
                 with torch.no_grad():
@@ -317,12 +318,16 @@ def train(args):
             stats["reward"] += float(reward.mean()) / horizon
             stats["diverged"] += int(terminal.sum())
             f = next_f
-            if replay.size >= args.warmup:
-                for _ in range(args.updates):
+            credit += args.updates
+            if replay.size >= args.warmup and (round_ > 0 or args.init):  # the input normalisation is set after round 0
+                while credit >= 1:
                     c, a, alpha = sac.update(replay.sample(args.batch))
+                    credit -= 1
                     updates += 1
                     stats["critic"] += c
                     stats["actor"] += a
+            else:
+                credit = 0.0
         if round_ == 0 and not args.init:
             x = np.concatenate(sample)
             sac.norm_mean = torch.from_numpy(x.mean(0))
@@ -331,7 +336,7 @@ def train(args):
         entry = {"round": round_, "control_steps": round_ * args.envs * horizon, "updates": updates, "seconds": round(seconds(), 1),
                  "train_reward": stats["reward"], "train_success": float(np.mean(info["success"])),
                  "train_position_error": float(np.mean(info["position_error"])), "diverged": stats["diverged"],
-                 "alpha": float(sac.log_alpha.exp()), "critic_loss": stats["critic"] / max(1, decisions * args.updates)}
+                 "alpha": float(sac.log_alpha.exp()), "critic_loss": stats["critic"] / max(1.0, decisions * args.updates)}
         if round_ % args.eval_every == 0:
             ev = evaluate(sac, eval_env, b, args.eval_seed, args.eval_targets, horizon)
             entry.update(eval_success=ev[0], eval_reached=ev[1], eval_position_error=ev[2], eval_rotation_error=ev[3])
@@ -347,6 +352,77 @@ def train(args):
         if args.stop_after and round_ == args.stop_after:
             return
     write_checkpoint()
+
+
+def distill(args):
+    """Behaviour cloning of the model executor (control/model_executor.hpp) into the same actor,
+    with DAgger: iteration 0 drives the arm with the model executor's torques plus Gaussian noise
+    of --noise N m on every actuated entry (so that the samples show recoveries), iteration i > 0
+    with the blend beta a_executor + (1 - beta) a_network, beta = 2^-i; every iteration records the
+    model executor's action at the states visited, and the network is refitted on everything
+    recorded (squared torque error in units of the limits, through basis()). The checkpoint has the
+    trainer's layout, so `export` writes it and `train --init` starts SAC from it."""
+    import torch
+    import torch.nn as nn
+    import manisoft
+
+    torch.set_num_threads(args.torch_threads)
+    torch.manual_seed(args.seed)
+    os.makedirs(args.out, exist_ok=True)
+    env = manisoft.make_env("reach", horizon=args.horizon)
+    high = np.asarray(env.action_space.high)
+    b = basis(high)
+    b_t = torch.from_numpy((b / high.reshape(-1)[:, None].clip(min=1)).T.copy()).float()  # torques in units of the limits
+    obs, _ = env.reset(seed=0)
+    one = lambda o: {k: np.asarray(v)[None] for k, v in o.items() if k != "time"}  # noqa: E731
+    args.gamma, args.tau = 0.99, 0.005  # unused by cloning; kept so the checkpoint trains on
+    sac = Sac(torch, nn, features(one(obs)).shape[1], b.shape[1], args)
+    optimiser = torch.optim.Adam(sac.actor.parameters(), lr=args.lr)
+    batches = np.random.default_rng(args.seed)
+    inputs, labels, log, started = [], [], [], time.time()
+    eval_env = manisoft.make_vec_env("reach", args.eval_targets, num_threads=args.threads, horizon=args.horizon)
+    for it in range(args.iterations):
+        for k in range(args.targets):
+            obs, _ = env.reset(seed=TRAIN_SEED_BASE + (args.seed << 32) + it * args.targets + k)
+            for t in range(args.horizon):
+                expert = np.array(env.expert_action())
+                f = features(one(obs))
+                if t % args.stride == 0:
+                    inputs.append(f[0].astype(np.float32))
+                    labels.append((expert / high.clip(min=1)).reshape(-1).astype(np.float32))
+                if it > 0:
+                    with torch.no_grad():
+                        _, _, u = sac.policy(torch.from_numpy(f.astype(np.float32)))
+                    beta = 0.5 ** it
+                    action = beta * expert + (1 - beta) * torques(u.numpy().astype(np.float64), b)[0]
+                else:
+                    action = expert + batches.normal(scale=args.noise, size=expert.shape) * (high > 0)
+                obs, _, terminated, truncated, _ = env.step(action)
+                if terminated or truncated:
+                    break
+        x, y = torch.from_numpy(np.stack(inputs)), torch.from_numpy(np.stack(labels))
+        if it == 0:
+            sac.norm_mean = x.mean(0)
+            sac.norm_scale = x.std(0).clamp(min=1e-2)
+        for _ in range(args.epochs):
+            order = torch.from_numpy(batches.permutation(len(x)))
+            for i in range(0, len(x), args.batch):
+                idx = order[i:i + args.batch]
+                out = sac.actor((x[idx] - sac.norm_mean) / sac.norm_scale)
+                loss = (torch.tanh(out[:, :b.shape[1]]) @ b_t - y[idx]).pow(2).mean()
+                optimiser.zero_grad()
+                loss.backward()
+                optimiser.step()
+        ev = evaluate(sac, eval_env, b, args.eval_seed, args.eval_targets, args.horizon)
+        with torch.no_grad():
+            fit = float((torch.tanh(sac.actor((x - sac.norm_mean) / sac.norm_scale)[:, :b.shape[1]]) @ b_t - y).pow(2).mean())
+        log.append({"iteration": it + 1, "samples": len(x), "loss": fit, "zero_torque_loss": float(y.pow(2).mean()),
+                    "seconds": round(time.time() - started, 1),
+                    "eval_success": ev[0], "eval_reached": ev[1], "eval_position_error": ev[2], "eval_rotation_error": ev[3]})
+        print(f"iteration {it + 1}: {len(x)} samples, loss {fit:.2e} (zero torques: {log[-1]['zero_torque_loss']:.2e}), "
+              f"{log[-1]['seconds']:.0f} s, eval success {ev[0]:.2f} "
+              f"reached {ev[1]:.2f} (|d_p| {ev[2]:.3f} m, |d_r| {ev[3]:.3f} rad)", flush=True)
+    save_atomic(torch, {"sac": sac.state(), "log": log, "args": vars(args), "distilled": True}, os.path.join(args.out, "checkpoint.pt"))
 
 
 def export(args):
@@ -416,18 +492,18 @@ def main(argv=None):
     t.add_argument("--stop-after", type=int, help="write a checkpoint and stop after this round (to test --resume)")
     t.add_argument("--resume", action="store_true", help="continue from --out's checkpoint")
     t.add_argument("--init", help="start from this checkpoint's networks (post-training, e.g. with R_s)")
-    t.add_argument("--envs", type=int, default=16, help="arms stepped together (default 16)")
+    t.add_argument("--envs", type=int, default=32, help="arms stepped together (default 32)")
     t.add_argument("--threads", type=int, default=2, help="environment threads (default 2)")
     t.add_argument("--torch-threads", type=int, default=1, help="PyTorch threads (default 1)")
     t.add_argument("--horizon", type=int, help="control steps an episode and a round last (default: the environment's 1500)")
-    t.add_argument("--repeat", type=int, default=10, help="control steps a decision holds its torques (default 10)")
+    t.add_argument("--repeat", type=int, default=1, help="control steps a decision holds its torques (default 1: the control rate)")
     t.add_argument("--stability-beta", type=float, default=0.0, help="R_s's beta (default 0: R_d alone, the paper's first phase)")
-    t.add_argument("--hidden", type=int, nargs="+", default=[256, 256], help="hidden layer sizes (default 256 256)")
+    t.add_argument("--hidden", type=int, nargs="+", default=[128, 128], help="hidden layer sizes (default 128 128)")
     t.add_argument("--lr", type=float, default=3e-4, help="Adam learning rate (the paper's 3e-4)")
     t.add_argument("--batch", type=int, default=256, help="minibatch (the paper's 256)")
     t.add_argument("--gamma", type=float, default=0.99, help="discount per decision (default 0.99)")
     t.add_argument("--tau", type=float, default=0.005, help="target networks' Polyak factor")
-    t.add_argument("--updates", type=int, default=2, help="gradient updates per decision of the batch (default 2)")
+    t.add_argument("--updates", type=float, default=0.25, help="gradient updates per decision of the batch, may be below 1 (default 0.25)")
     t.add_argument("--warmup", type=int, default=10000, help="uniform random decisions before learning (default 10000)")
     t.add_argument("--buffer", type=int, default=1000000, help="replay capacity in decisions (default 1e6)")
     t.add_argument("--eval-every", type=int, default=10, help="rounds between evaluations (default 10)")
@@ -435,6 +511,22 @@ def main(argv=None):
     t.add_argument("--eval-seed", type=int, default=7, help="their reach_eval seed (default 7)")
     t.add_argument("--checkpoint-minutes", type=float, default=5.0, help="minutes between checkpoints (default 5)")
     t.add_argument("--seed", type=int, default=0, help="training seed (episodes, networks, exploration)")
+    d = sub.add_parser("distill", help="behaviour cloning of the model executor with DAgger (checkpoint in --out)")
+    d.add_argument("--out", required=True)
+    d.add_argument("--iterations", type=int, default=4, help="DAgger iterations (default 4)")
+    d.add_argument("--targets", type=int, default=100, help="targets an iteration (default 100)")
+    d.add_argument("--stride", type=int, default=3, help="record every k-th control step (default 3)")
+    d.add_argument("--noise", type=float, default=2.0, help="N m of Gaussian noise on the executor's torques in iteration 0 (default 2)")
+    d.add_argument("--epochs", type=int, default=10, help="passes over the recorded samples per iteration (default 10)")
+    d.add_argument("--horizon", type=int, default=1500, help="control steps an episode (default 1500)")
+    d.add_argument("--hidden", type=int, nargs="+", default=[128, 128], help="hidden layer sizes (default 128 128)")
+    d.add_argument("--lr", type=float, default=1e-3)
+    d.add_argument("--batch", type=int, default=256)
+    d.add_argument("--threads", type=int, default=2, help="evaluation threads")
+    d.add_argument("--torch-threads", type=int, default=1)
+    d.add_argument("--eval-targets", type=int, default=32)
+    d.add_argument("--eval-seed", type=int, default=7)
+    d.add_argument("--seed", type=int, default=0)
     e = sub.add_parser("export", help="write a checkpoint's policy as an MLP executor weight file")
     e.add_argument("checkpoint")
     e.add_argument("out")
@@ -443,7 +535,7 @@ def main(argv=None):
     c.add_argument("out")
     c.add_argument("--targets", type=int, default=32, help="targets per evaluation (the run's --eval-targets)")
     args = p.parse_args(argv)
-    {"train": train, "export": export, "curves": curves}[args.command](args)
+    {"train": train, "distill": distill, "export": export, "curves": curves}[args.command](args)
 
 
 if __name__ == "__main__":

@@ -71,6 +71,21 @@ class SacExecutorTest(unittest.TestCase):
             np.testing.assert_allclose(action, expected, atol=1e-4 * 150)  # float32 network, double executor
             obs, *_ = env.step(action)
 
+    def test_distilled_executor_fits_the_model_executor_and_starts_sac(self):
+        out = os.path.join(self.dir.name, "distilled")
+        sac_executor.main(["distill", "--out", out, "--iterations", "2", "--targets", "2", "--horizon", "300", "--epochs", "150",
+                           "--hidden", "32", "32", "--eval-targets", "2", "--seed", "3"])
+        log = torch.load(os.path.join(out, "checkpoint.pt"))["log"]
+        self.assertEqual([e["samples"] for e in log], [200, 400])  # 2 targets x 300 steps / stride 3, twice
+        # the network's torques are much closer to the model executor's than zero torques on its own
+        # noisy episodes, and closer on the blended DAgger episodes' states too
+        self.assertLess(log[0]["loss"], 0.1 * log[0]["zero_torque_loss"])
+        self.assertLess(log[1]["loss"], 0.5 * log[1]["zero_torque_loss"])
+        sac_executor.main(["export", os.path.join(out, "checkpoint.pt"), os.path.join(out, "executor.mlp")])
+        self.assertEqual(manisoft.MlpExecutor(os.path.join(out, "executor.mlp")).act(manisoft.make_env("reach").reset(seed=1)[0]).shape, (20, 3))
+        tuned = train(os.path.join(self.dir.name, "tuned"), "--rounds", "1", "--init", os.path.join(out, "checkpoint.pt"), "--hidden", "32", "32")
+        self.assertGreater(tuned["updates"], 0)
+
     def test_stability_beta_switches_the_paper_stability_term(self):
         # The model executor's actions, replayed in batches with beta = 1 and beta = 0: the rewards
         # differ by R_s = -sgn(d_t - d_{t-1}) while d = |d_p| + 0.2 |d_r| <= D = 0.3, else 0.
