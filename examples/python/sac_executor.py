@@ -7,7 +7,7 @@ evaluates it beside the model executor.
     /usr/bin/python3 -m manisoft.sac_executor train --out sac/run --minutes 60
     /usr/bin/python3 -m manisoft.sac_executor export sac/run/checkpoint.pt sac/executor.mlp
     reach_eval --executor mlp --weights sac/executor.mlp --targets 100 --seed 1 --set table
-    /usr/bin/python3 -m manisoft.sac_executor curves sac/run sac/curves.png
+    /usr/bin/python3 -m manisoft.sac_executor curves sac/curves.png sac/run
 
 Environment: manisoft.make_vec_env("reach", --envs) (every arm its own target of the table set;
 the paper's arm, 714 Hz control, horizon 1500 control steps). The reward is the environment's own
@@ -130,7 +130,8 @@ class Sac:
         x = torch_cat(self.torch, (obs - self.norm_mean) / self.norm_scale, u)
         return nets[0](x).squeeze(1), nets[1](x).squeeze(1)
 
-    def update(self, batch):
+    def update(self, batch, train_actor=True):
+        """One gradient step of the critics and, when train_actor, of the actor and the temperature."""
         torch, a = self.torch, self.args
         obs, u, reward, next_obs, done = (torch.from_numpy(x) for x in batch)
         alpha = self.log_alpha.exp().detach()
@@ -143,6 +144,9 @@ class Sac:
         self.critic_opt.zero_grad()
         critic_loss.backward()
         self.critic_opt.step()
+        if not train_actor:
+            self.polyak()
+            return float(critic_loss), 0.0, float(alpha)
         for p in self.critics.parameters():
             p.requires_grad_(False)
         new_u, logp, _ = self.policy(obs)
@@ -157,10 +161,13 @@ class Sac:
         self.alpha_opt.zero_grad()
         alpha_loss.backward()
         self.alpha_opt.step()
-        with torch.no_grad():
-            for p, t in zip(self.critics.parameters(), self.targets.parameters()):
-                t.mul_(1 - a.tau).add_(a.tau * p)
+        self.polyak()
         return float(critic_loss), float(actor_loss), float(alpha)
+
+    def polyak(self):
+        with self.torch.no_grad():
+            for p, t in zip(self.critics.parameters(), self.targets.parameters()):
+                t.mul_(1 - self.args.tau).add_(self.args.tau * p)
 
     def state(self):
         return {"actor": self.actor.state_dict(), "critics": self.critics.state_dict(), "targets": self.targets.state_dict(),
@@ -277,6 +284,13 @@ def train(args):
         print(f"resumed at round {round_} ({updates} updates)", flush=True)
     elif args.init:
         sac.load(torch.load(args.init)["sac"], weights_only=True)
+        if args.init_log_std is not None:  # a fixed exploration noise around the loaded policy's mean
+            head = sac.actor[-1]
+            with torch.no_grad():
+                head.weight[act_size:].zero_()
+                head.bias[act_size:].fill_(args.init_log_std)
+        with torch.no_grad():
+            sac.log_alpha.fill_(math.log(args.init_alpha))
         print(f"initialised from {args.init}", flush=True)
     eval_env = manisoft.make_vec_env("reach", args.eval_targets, num_threads=args.threads, horizon=args.horizon,
                                      stability_beta=args.stability_beta)
@@ -321,7 +335,7 @@ def train(args):
             credit += args.updates
             if replay.size >= args.warmup and (round_ > 0 or args.init):  # the input normalisation is set after round 0
                 while credit >= 1:
-                    c, a, alpha = sac.update(replay.sample(args.batch))
+                    c, a, alpha = sac.update(replay.sample(args.batch), updates >= args.actor_delay)
                     credit -= 1
                     updates += 1
                     stats["critic"] += c
@@ -431,7 +445,8 @@ def export(args):
     import torch
     import manisoft
 
-    s = torch.load(args.checkpoint)["sac"]
+    checkpoint = torch.load(args.checkpoint)
+    s = checkpoint["sac"]
     high = np.asarray(manisoft.make_vec_env("reach", 1, num_threads=1).single_action_space.high)
     weights = [(v.double().numpy(), s["actor"][k.replace("weight", "bias")].double().numpy())
                for k, v in s["actor"].items() if k.endswith("weight")]
@@ -446,7 +461,8 @@ def export(args):
     activations.append("linear")
     tmp = args.out + ".tmp"
     with open(tmp, "w") as out:
-        out.write(f"manisoft-mlp 1\n# SAC executor exported from {os.path.basename(args.checkpoint)}\n")
+        how = "cloned from the model executor (distill)" if checkpoint.get("distilled") else "trained with SAC"
+        out.write(f"manisoft-mlp 1\n# MLP executor {how}: manisoft.sac_executor export\n")
         out.write(f"layers {len(weights)}\ninput {weights[0][0].shape[1]}\n")
         for (w, b), act in zip(weights, activations):
             out.write(f"layer {w.shape[0]} {act}\n")
@@ -458,25 +474,30 @@ def export(args):
 
 
 def curves(args):
+    """Each run's evaluations (held-out targets, the deterministic policy at every control step)
+    against its training time: success (held 100 control steps) and reached (the paper's criterion)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     import torch
-    log = torch.load(os.path.join(args.run, "checkpoint.pt"))["log"]
-    ev = [e for e in log if "eval_success" in e]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
-    for ax, x, label in ((axes[0], [e["control_steps"] / 1e6 for e in ev], "control steps (millions)"),
-                         (axes[1], [e["seconds"] / 60 for e in ev], "training time (minutes, 2 cores)")):
-        ax.plot(x, [100 * e["eval_success"] for e in ev], label="success (held 100 steps)")
-        ax.plot(x, [100 * e["eval_reached"] for e in ev], label="reached (paper's criterion)")
-        ax.axhline(54, color="gray", linestyle="--", label="paper's SAC executor (54%)")
-        ax.set_xlabel(label)
-        ax.set_ylabel(f"% of {args.targets} held-out targets")
-        ax.set_ylim(0, 100)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+    for run in args.runs:
+        log = [e for e in torch.load(os.path.join(run, "checkpoint.pt"))["log"] if "eval_success" in e]
+        minutes = [e["seconds"] / 60 for e in log]
+        name = os.path.basename(os.path.normpath(run))
+        axes[0].plot(minutes, [100 * e["eval_success"] for e in log], marker=".", label=name)
+        axes[1].plot(minutes, [100 * e["eval_reached"] for e in log], marker=".", label=name)
+    for ax, title in ((axes[0], "success: within 0.03 m / 0.3 rad, held 100 control steps"),
+                      (axes[1], "reached: within 0.03 m / 0.3 rad once (the paper's criterion)")):
+        ax.axhline(54, color="gray", linestyle="--", label="paper's SAC executor, reached (54%)")
+        ax.set_title(title, fontsize=10)
+        ax.set_xlabel("training time (minutes, this 2-core machine)")
+        ax.set_ylim(-2, 100)
         ax.grid(alpha=0.3)
-    axes[0].legend(loc="upper left")
-    fig.suptitle("SAC executor on the reach benchmark (table targets, deterministic policy)")
+    axes[0].set_ylabel(f"% of {args.targets} held-out table targets")
+    axes[1].legend(loc="upper right", fontsize=8)
+    fig.suptitle("Learned executors on the reach benchmark (deterministic policy, a decision every control step)")
     fig.tight_layout()
     fig.savefig(args.out, dpi=110)
     print(f"wrote {args.out}")
@@ -491,7 +512,10 @@ def main(argv=None):
     t.add_argument("--rounds", type=int, help="stop after this many rounds (envs x 1500 control steps each)")
     t.add_argument("--stop-after", type=int, help="write a checkpoint and stop after this round (to test --resume)")
     t.add_argument("--resume", action="store_true", help="continue from --out's checkpoint")
-    t.add_argument("--init", help="start from this checkpoint's networks (post-training, e.g. with R_s)")
+    t.add_argument("--init", help="start from this checkpoint's networks (post-training, e.g. with R_s, or a distilled actor)")
+    t.add_argument("--init-log-std", type=float, help="with --init: the actor's log standard deviation, fixed to this at the start")
+    t.add_argument("--init-alpha", type=float, default=1.0, help="with --init: the entropy temperature to start from (default 1)")
+    t.add_argument("--actor-delay", type=int, default=0, help="updates of the critics alone before the actor learns (default 0)")
     t.add_argument("--envs", type=int, default=32, help="arms stepped together (default 32)")
     t.add_argument("--threads", type=int, default=2, help="environment threads (default 2)")
     t.add_argument("--torch-threads", type=int, default=1, help="PyTorch threads (default 1)")
@@ -530,9 +554,9 @@ def main(argv=None):
     e = sub.add_parser("export", help="write a checkpoint's policy as an MLP executor weight file")
     e.add_argument("checkpoint")
     e.add_argument("out")
-    c = sub.add_parser("curves", help="plot a run's evaluations (PNG)")
-    c.add_argument("run")
+    c = sub.add_parser("curves", help="plot runs' evaluations against training time (PNG)")
     c.add_argument("out")
+    c.add_argument("runs", nargs="+", help="run folders (train or distill --out)")
     c.add_argument("--targets", type=int, default=32, help="targets per evaluation (the run's --eval-targets)")
     args = p.parse_args(argv)
     {"train": train, "distill": distill, "export": export, "curves": curves}[args.command](args)

@@ -83,7 +83,8 @@ class SacExecutorTest(unittest.TestCase):
         self.assertLess(log[1]["loss"], 0.5 * log[1]["zero_torque_loss"])
         sac_executor.main(["export", os.path.join(out, "checkpoint.pt"), os.path.join(out, "executor.mlp")])
         self.assertEqual(manisoft.MlpExecutor(os.path.join(out, "executor.mlp")).act(manisoft.make_env("reach").reset(seed=1)[0]).shape, (20, 3))
-        tuned = train(os.path.join(self.dir.name, "tuned"), "--rounds", "1", "--init", os.path.join(out, "checkpoint.pt"), "--hidden", "32", "32")
+        tuned = train(os.path.join(self.dir.name, "tuned"), "--rounds", "1", "--init", os.path.join(out, "checkpoint.pt"), "--hidden", "32", "32",
+                      "--init-log-std", "-3", "--actor-delay", "3")
         self.assertGreater(tuned["updates"], 0)
 
     def test_stability_beta_switches_the_paper_stability_term(self):
