@@ -108,7 +108,7 @@ Options parse(int argc, char** argv, int& exit_code) {
   app.add_option("--tol-pos", o.tol_pos, "position tolerance, m (default 0.03)")->check(cli::positive());
   app.add_option("--tol-rot", o.tol_rot, "rotation tolerance, rad (default 0.3)")->check(cli::positive());
   app.add_option("--hold-steps", o.hold_steps, "control steps the tolerance must hold for a success (default 100; 1: reached once)")
-      ->check(CLI::Range(1, manisoft::env::ReachEnvConfig{}.horizon));
+      ->check(cli::between(1, manisoft::env::ReachEnvConfig{}.horizon));
   app.add_option("--damping", o.damping, "the simulated rod's damping: analytical[:NU] (default analytical:0.1) or uniform[:GAMMA]");
   app.add_option("--action", o.action, "elements (default), bspline[:K] or bspline-pinned[:K]");
   app.add_option("--max-node-speed", o.max_node_speed, "model executor: planned peak node speed of a smooth ramp, m/s")->check(cli::positive());

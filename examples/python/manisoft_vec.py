@@ -434,16 +434,18 @@ class TaskVectorEnv(_VectorEnv):
     layout), one control step. action_mode="ee_pose": num_envs x 7 end-effector actions (target
     position, rotation vector from the home orientation, S: make_env's ee_pose layout), each arm's
     target tracked by its own model executor for action_repeat control steps (fewer when its
-    episode ends; infos["control_steps"]), as make_env(..., action_mode="ee_pose") does; infos
-    ["ee_command"] says what each command did ("line", "ramp", "kept", "refused"). Autoreset NEXT_STEP: an ended arm (terminated: success or a terminal failure;
-    truncated: the horizon T) starts its next scene (index + num_envs) at the next step, whose
-    action for it is ignored.
+    episode ends; infos["control_steps"]), as make_env(..., action_mode="ee_pose") does;
+    infos["ee_command"] says what each command did ("line", "ramp", "kept", "refused").
+    Autoreset NEXT_STEP: an ended arm (terminated: success or a terminal failure; truncated: the
+    horizon T) starts its next scene (index + num_envs) at the next step, whose action for it is
+    ignored.
     Observations: rod_nodes (B x (n + 1) x 3), end_effector, gripper_pose (B x 4 x 4),
     gripper_width (B), gripper_state (B), object_poses (B x K x 4 x 4: the first object_count[i]
     are arm i's objects, the others zero), object_count (B), instruction (a tuple of B str).
     Infos: success, steps, control_steps (the step's), failure (the task layer's reason: None or a
-    name, a tuple of B), seed (each arm's scene index), with Gymnasium's "_key" masks. Arrays are read-only views of the
-    batch's buffers, overwritten by the next reset or step (copy what you keep).
+    name, a tuple of B), seed (each arm's scene index), with Gymnasium's "_key" masks. Arrays are
+    read-only views of the batch's buffers, overwritten by the next reset or step (copy what you
+    keep).
     """
 
     _OBSERVATIONS = ("rod_nodes", "end_effector", "gripper_pose", "gripper_width", "gripper_state", "object_poses", "object_count")

@@ -128,6 +128,7 @@ def reach_eval_cases():
     refused(reach_eval, ["--seed", "1", "--load-kg", "1e30", "--out", out], ["--load-kg must be in [0, 15.29051988] (got 1e30)"], [out], 2)
     refused(reach_eval, ["--seed", "-1", "--out", out], ["--seed must be in [0, 1e+15] (got -1)"], [out], 2)
     refused(reach_eval, ["--seed", "1", "--tol-pos", "0", "--out", out], ["--tol-pos must be > 0 (got 0)"], [out], 2)
+    refused(reach_eval, ["--seed", "1", "--hold-steps", "0", "--out", out], ["--hold-steps must be in [1, 1500] (got 0)"], [out], 2)
     refused(reach_eval, ["--seed", "1", "--targets", "1", "--out", "/dev/full"], ["writing '/dev/full' failed"], code=1)
     if reach_eval and "--load-kg" not in accepted(reach_eval, ["--help"]):
         failures.append("reach_eval --help does not list --load-kg")

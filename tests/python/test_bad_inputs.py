@@ -101,7 +101,18 @@ class BadInputs(unittest.TestCase):
         self.refused("vec.step(zeros with [1, 4] = nan)", lambda: vec.step(bad), ValueError, "arm 1")
         self.refused("vec.step(np.zeros(3))", lambda: vec.step(np.zeros(3)), ValueError, "shape")
         self.refused('make_vec_env("reach", 0)', lambda: manisoft.make_vec_env("reach", 0), ValueError, "num_envs")
+        self.refused('make_vec_env("reach", 2, stability_beta=-1)', lambda: manisoft.make_vec_env("reach", 2, stability_beta=-1), ValueError,
+                     "beta = -1")
         vec.close()
+        vec_ee = manisoft.make_vec_env("COLL", 2, num_threads=1, action_mode="ee_pose")
+        vec_ee.reset(seed=0)
+        bad = np.zeros((2, 7))
+        bad[1, 5] = np.nan
+        self.refused('make_vec_env("COLL", 2, action_mode="ee_pose").step(zeros with [1, 5] = nan)', lambda: vec_ee.step(bad), ValueError,
+                     "arm 1: action entry 5 (rz) = nan")
+        vec_ee.close()
+        self.refused('make_vec_env("COLL", 2, action_mode="ee_pose", action_repeat=0)',
+                     lambda: manisoft.make_vec_env("COLL", 2, action_mode="ee_pose", action_repeat=0), ValueError, "action_repeat = 0")
         self.evaluate_flags()
         failures = []
         TABLE.finish(failures)

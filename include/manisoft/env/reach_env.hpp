@@ -17,8 +17,8 @@
 // Observation: target, end-effector pose (the gripper's attachment frame: centre of the palm's
 // top face), positions and velocities of every `observe_stride`-th node (always the tip).
 // Reward: R = R_d + R_s of the paper (d = |d_p| + 0.2 |d_r|; k1 = 0.5, k2 = 1.5, d1 = 0.1,
-// d2 = 0.05; beta = 1, D = 0.3 by default: config.stability). Success: within tolerance, then held for `hold_steps` control
-// steps (first_success_step is the first step of that held window). A diverged simulation step
+// d2 = 0.05; config.stability: beta = 1, D = 0.3 by default). Success: within tolerance, then
+// held for `hold_steps` control steps (first_success_step is the first step of that held window). A diverged simulation step
 // ends the episode (info.diverged; the world keeps its state before the step); invalid input
 // (a malformed action) is refused with manisoft::InvalidInput and changes nothing.
 //

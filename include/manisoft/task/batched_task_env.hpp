@@ -32,7 +32,7 @@
 //   steps            B                 control steps of the current episode
 //   failure          B                 FailureReason as an integer (0: none)
 //   indices          B                 the scene index of each arm's current episode
-//   ee_command       B                 the end-effector track's EeCommand of the step (0 on the torque track)
+//   ee_command       B                 the end-effector track's EeCommand of the step (unused on the torque track)
 //   control_steps    B                 control steps the step ran (0 at a reset)
 // Flags are std::uint8_t 0 / 1. The instruction of arm i's scene is instruction(i).
 //
