@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """The paper's learned executor (section 3.4, appendix "Details for Executor Training"): an MLP
-policy trained with soft actor-critic (SAC) on the batched reach environment, exported in the
-weight format of control/mlp_executor.hpp so that `reach_eval --executor mlp --weights FILE`
-evaluates it beside the model executor.
+policy trained with soft actor-critic (SAC) on the batched reach environment, or cloned from the
+model executor (distill), exported in the weight format of control/mlp_executor.hpp so that
+`reach_eval --executor mlp --weights FILE` evaluates it beside the model executor. What each
+reaches, and why SAC falls short of the paper's executor here: BENCHMARKS.md, "Learned executors".
 
     /usr/bin/python3 -m manisoft.sac_executor train --out sac/run --minutes 60
+    /usr/bin/python3 -m manisoft.sac_executor distill --out sac/distilled
     /usr/bin/python3 -m manisoft.sac_executor export sac/run/checkpoint.pt sac/executor.mlp
     reach_eval --executor mlp --weights sac/executor.mlp --targets 100 --seed 1 --set table
     /usr/bin/python3 -m manisoft.sac_executor curves sac/curves.png sac/run
@@ -20,10 +22,10 @@ network's first layer). Action: a tanh-squashed Gaussian of 12 values in (-1, 1)
 a torque profile along the arm (constant, linear and quadratic terms over elements 1..18, and the
 tip element's own value; basis()), in units of the axis's limit: the model executor's holding
 torques have this shape (linear along the arm, the tip element apart), and 57 independent element
-torques did not learn (BENCHMARKS.md, "SAC executor"). The exported network ends with the basis
-as a linear layer, so it outputs the element torques. The policy decides every --repeat control
-steps and its torques are held in between (the executor, exported, decides at every control
-step). The decision's reward is the mean of its control steps' rewards.
+torques did not learn. The exported network ends with the basis as a linear layer, so it outputs
+the element torques. The policy decides every --repeat control steps (default 1: the arm's held
+poses need a loop at the control rate) and its torques are held in between (the exported executor
+decides at every control step). The decision's reward is the mean of its control steps' rewards.
 SAC: twin critics with target networks (Polyak tau = 0.005), an entropy temperature tuned to the
 target entropy -12, Adam at the paper's learning rate 3e-4 and batch 256, gamma per decision.
 Rounds: every arm starts an episode of its own seed (distinct from reach_eval's target seeds) at
@@ -38,7 +40,6 @@ renamed): networks, optimisers, replay buffer, random generators and log; --resu
 one and ends with the weights an uninterrupted run gives (CPU, the same --torch-threads).
 """
 import argparse
-import json
 import math
 import os
 import sys
@@ -127,7 +128,7 @@ class Sac:
         return u, log_prob, torch.tanh(mean)
 
     def q(self, nets, obs, u):
-        x = torch_cat(self.torch, (obs - self.norm_mean) / self.norm_scale, u)
+        x = self.torch.cat([(obs - self.norm_mean) / self.norm_scale, u], dim=1)
         return nets[0](x).squeeze(1), nets[1](x).squeeze(1)
 
     def update(self, batch, train_actor=True):
@@ -188,10 +189,6 @@ class Sac:
         self.critic_opt.load_state_dict(s["critic_opt"])
         self.alpha_opt.load_state_dict(s["alpha_opt"])
         self.generator.set_state(s["generator"])
-
-
-def torch_cat(torch, a, b):
-    return torch.cat([a, b], dim=1)
 
 
 class Replay:
