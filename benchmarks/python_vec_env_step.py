@@ -9,7 +9,9 @@ With --env TASK the same for a task (make_env(TASK, render=False, privileged=Tru
 make_vec_env(TASK, B)): arms get zero torques with the gripper open, so the arm falls onto the
 table and the objects: each step has the rod, the gripper, the objects and their contacts; an
 episode that ends (an object knocked off the table) resets within the timing, as a vector
-environment's autoreset does.
+environment's autoreset does. --render W H adds the camera image of every arm at every step
+(make_env(TASK, render=True, camera=...) against make_vec_env(TASK, B, render=True, camera=...):
+one renderer per single environment against one per thread of the vector environment).
 Run: PYTHONPATH=build/<config>/python /usr/bin/python3 benchmarks/python_vec_env_step.py [--env ALN]
 """
 import argparse
@@ -31,13 +33,13 @@ def env_action(env):
     return mild_action(20) if env == "reach" else np.zeros(61)
 
 
-def make_single(env, i):
+def make_single(env, i, camera):
     """A single environment of `env`, reset (a task: to scene index i, as make_vec_env's arm i)."""
     if env == "reach":
         single = manisoft.make_env("reach", seed=i)
         single.reset()
         return single
-    single = manisoft.make_env(env, "clean", seed=0, render=False, privileged=True)
+    single = manisoft.make_env(env, "clean", seed=0, render=camera is not None, camera=camera, privileged=True)
     single.reset(options={"index": i})
     return single
 
@@ -74,13 +76,18 @@ def main():
     p.add_argument("--threads", type=int, nargs="+", default=[2, 1], help="make_vec_env's num_threads, each measured")
     p.add_argument("--arms", type=int, nargs="+", default=[1, 8, 64])
     p.add_argument("--env", default="reach", help="reach, or a task (COLL, ALN, STK, ARR, OVR)")
+    p.add_argument("--render", type=int, nargs=2, metavar=("W", "H"), help="a task: every arm's camera image at W x H pixels, every step")
     args = p.parse_args()
+    if args.render and args.env == "reach":
+        p.error("--render needs a task (--env)")
+    camera = {"width": args.render[0], "height": args.render[1]} if args.render else None
+    options = {"render": True, "camera": camera} if camera else {}
     action = env_action(args.env)
     for arms in args.arms:
-        envs = [make_single(args.env, i) for i in range(arms)]
+        envs = [make_single(args.env, i, camera) for i in range(arms)]
         report("Python loop, make_env", arms, 1, args.steps, [time_loop(envs, args.steps, action) for _ in range(args.repeats)])
         for threads in args.threads:
-            vec = manisoft.make_vec_env(args.env, arms, num_threads=threads, seed=0)
+            vec = manisoft.make_vec_env(args.env, arms, num_threads=threads, seed=0, **options)
             vec.reset()
             report("make_vec_env", arms, threads, args.steps, [time_vec(vec, args.steps, action) for _ in range(args.repeats)])
             vec.close()

@@ -37,6 +37,7 @@
 #include "manisoft/env/batched_reach_env.hpp"
 #include "manisoft/env/reach_env.hpp"
 #include "manisoft/task/batched_task_env.hpp"
+#include "manisoft/task/batched_task_images.hpp"
 #include "task_environment.hpp"
 
 namespace py = pybind11;
@@ -333,8 +334,24 @@ class ReachBatch : public BatchHandle<manisoft::env::BatchedReachEnv<>> {
 class TaskBatch : public BatchHandle<manisoft::task::BatchedTaskEnv> {
  public:
   TaskBatch(const std::string& task, const std::string& setting, const std::string& split, std::uint64_t seed, int num_envs, int threads,
-            const std::string& action_mode, int action_repeat)
-      : BatchHandle(num_envs, threads, settings(task, setting, split, seed, action_mode, action_repeat)) {}
+            const std::string& action_mode, int action_repeat, bool render, const std::optional<py::dict>& camera)
+      : BatchHandle(num_envs, threads, settings(task, setting, split, seed, action_mode, action_repeat)) {
+    if (!render) {
+      if (camera) throw py::value_error("make_vec_env: camera is given but render=False");
+      return;
+    }
+    // as make_env's camera: a dict replaces the scene's camera (unset keys: the defaults); none: each scene's own
+    const std::optional<manisoft::render::Camera> c = camera ? std::optional(manisoft_py::camera_of(*camera, {})) : std::nullopt;
+    const manisoft::render::Camera size = c ? *c : manisoft::render::Camera{};
+    images_ = std::make_unique<manisoft::task::BatchedTaskImages>(batch_, size.width, size.height, c);
+  }
+
+  /// As BatchHandle::reset; a rendering batch is bound to the thread of its first reset (its
+  /// renderer on part 0 has its EGL context there).
+  void reset(const Seeds& values, const std::optional<Flags>& mask) {
+    BatchHandle::reset(values, mask);
+    if (images_) threads_.bind();
+  }
 
   static py::dict arrays(const py::object& owner) {
     const auto& b = owner.cast<const TaskBatch&>().batch_;
@@ -355,6 +372,11 @@ class TaskBatch : public BatchHandle<manisoft::task::BatchedTaskEnv> {
     d["failure"] = batch_view(b.failure(), {n}, owner);
     d["indices"] = batch_view(b.indices(), {n}, owner);
     d["control_steps"] = batch_view(b.control_steps(), {n}, owner);
+    if (const auto& images = owner.cast<const TaskBatch&>().images_) {
+      py::array image(py::dtype::of<std::uint8_t>(), std::vector<py::ssize_t>{n, images->height(), images->width(), 3}, {}, images->images().data(), owner);
+      py::detail::array_proxy(image.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+      d["image"] = image;
+    }
     return d;
   }
 
@@ -387,8 +409,12 @@ class TaskBatch : public BatchHandle<manisoft::task::BatchedTaskEnv> {
   int max_objects() const { return batch_.max_objects(); }
   bool ee_pose() const { return batch_.settings().ee_track.has_value(); }
   py::dict action_space() const { return ee_pose() ? manisoft_py::ee_action_spec() : manisoft_py::task_action_spec(batch_.n_elements()); }
+  /// The images' height and width, or None without rendering.
+  py::object image_size() const { return images_ ? py::object(py::make_tuple(images_->height(), images_->width())) : py::object(py::none()); }
 
  private:
+  std::unique_ptr<manisoft::task::BatchedTaskImages> images_;  // declared after the batch: released first
+
   static manisoft::task::BatchedTaskEnv::Settings settings(const std::string& task, const std::string& setting, const std::string& split, std::uint64_t seed,
                                                           const std::string& action_mode, int action_repeat) {
     manisoft::task::BatchedTaskEnv::Settings s;
@@ -474,8 +500,10 @@ PYBIND11_MODULE(_manisoft, m) {
       .def("_action_space_spec", &ReachBatch::action_space)
       .def("_observation_space_spec", &ReachBatch::observation_space);
   py::class_<TaskBatch>(m, "_TaskBatch", "B task environments stepped together (use manisoft.make_vec_env)")
-      .def(py::init<const std::string&, const std::string&, const std::string&, std::uint64_t, int, int, const std::string&, int>(), py::arg("task"),
-           py::arg("setting"), py::arg("split"), py::arg("seed"), py::arg("num_envs"), py::arg("threads"), py::arg("action_mode"), py::arg("action_repeat"))
+      .def(py::init<const std::string&, const std::string&, const std::string&, std::uint64_t, int, int, const std::string&, int, bool,
+                    const std::optional<py::dict>&>(),
+           py::arg("task"), py::arg("setting"), py::arg("split"), py::arg("seed"), py::arg("num_envs"), py::arg("threads"), py::arg("action_mode"),
+           py::arg("action_repeat"), py::arg("render") = false, py::arg("camera") = py::none())
       .def("reset", &TaskBatch::reset, py::arg("indices"), py::arg("mask") = py::none())
       .def("step", &TaskBatch::step, py::arg("actions"))
       .def("arrays", [](const py::object& self) { return TaskBatch::arrays(self); })
@@ -486,6 +514,7 @@ PYBIND11_MODULE(_manisoft, m) {
       .def_property_readonly("threads", &TaskBatch::threads)
       .def_property_readonly("n_elements", &TaskBatch::n_elements)
       .def_property_readonly("max_objects", &TaskBatch::max_objects)
+      .def_property_readonly("image_size", &TaskBatch::image_size)
       .def("_action_space_spec", &TaskBatch::action_space)
       .def("_observation_space_spec", [](const TaskBatch&) { return py::dict(); });
   using manisoft_py::TaskEnvironment;

@@ -420,7 +420,7 @@ class ReachVectorEnv(_VectorEnv):
 
 class TaskVectorEnv(_VectorEnv):
     """num_envs environments of one task and setting stepped together (Gymnasium 1.x VectorEnv API),
-    with the privileged state observation (no image).
+    with the privileged state observation, and with render=True the camera image.
 
     Arm i of the batch follows exactly the episode of make_env(task, setting, seed=seed,
     render=False, privileged=True) reset to the same scene and given the same actions, whatever
@@ -441,7 +441,12 @@ class TaskVectorEnv(_VectorEnv):
     ignored.
     Observations: rod_nodes (B x (n + 1) x 3), end_effector, gripper_pose (B x 4 x 4),
     gripper_width (B), gripper_state (B), object_poses (B x K x 4 x 4: the first object_count[i]
-    are arm i's objects, the others zero), object_count (B), instruction (a tuple of B str).
+    are arm i's objects, the others zero), object_count (B), instruction (a tuple of B str);
+    render=True: image (B x H x W x 3 uint8), each arm's camera image drawn on the worker thread
+    that stepped it (one renderer per thread), the pixels make_env(..., render=True, camera=camera)
+    gives in the same state; camera: as make_env's (a dict replacing each scene's camera; None:
+    each scene's own at 514 x 514). A rendering environment is used from the thread of its first
+    reset.
     Infos: success, steps, control_steps (the step's), failure (the task layer's reason: None or a
     name, a tuple of B), seed (each arm's scene index), with Gymnasium's "_key" masks. Arrays are
     read-only views of the batch's buffers, overwritten by the next reset or step (copy what you
@@ -453,13 +458,13 @@ class TaskVectorEnv(_VectorEnv):
     _EPISODE = "indices"
 
     def __init__(self, task, num_envs, num_threads=None, setting="clean", split="train", seed=0, first_index=0,
-                 action_mode="torque", action_repeat=None):
+                 action_mode="torque", action_repeat=None, render=False, camera=None):
         num_envs, num_threads = _checked_counts(num_envs, num_threads)
         self.task, self.setting, self.split, self.action_mode = task, setting, split, action_mode
         self.action_repeat = 1 if action_mode == "torque" else (ACTION_REPEAT if action_repeat is None else int(action_repeat))  # noqa: F821
         self._ACTION_LAYOUT = "(num_envs, 7)" if action_mode == "ee_pose" else "(num_envs, 3n + 1)"
         batch = _TaskBatch(task, setting, split, _count(seed, "make_vec_env: seed"), num_envs, num_threads, action_mode,  # noqa: F821
-                           self.action_repeat)
+                           self.action_repeat, bool(render), camera)
         self.horizon = HORIZON  # noqa: F821 (compiled constant)
         self.single_action_space, _ = _spaces_of(batch)
         n, k = batch.n_elements, batch.max_objects
@@ -468,6 +473,9 @@ class TaskVectorEnv(_VectorEnv):
             "rod_nodes": unbounded(n + 1, 3), "end_effector": unbounded(4, 4), "gripper_pose": unbounded(4, 4),
             "gripper_width": unbounded(), "gripper_state": Box(0, 1, (), np.int64), "object_poses": unbounded(k, 4, 4),
             "object_count": Box(0, k, (), np.int64)})
+        if batch.image_size is not None:
+            self.single_observation_space.spaces["image"] = Box(0, 255, (*batch.image_size, 3), np.uint8)
+            self._OBSERVATIONS = self._OBSERVATIONS + ("image",)
         self._instructions = None
         super().__init__(batch, first_index)
 
@@ -504,8 +512,9 @@ def make_vec_env(name, num_envs, num_threads=None, **kwargs):
       make_vec_env("reach", num_envs, num_threads=None, target_set="table"|"equilibria", seed=0,
                     horizon=HORIZON, stability_beta=1.0) -> ReachVectorEnv
       make_vec_env(task, num_envs, num_threads=None, setting="clean", split="train", seed=0,
-                    first_index=0, action_mode="torque"|"ee_pose", action_repeat=36) -> TaskVectorEnv
-                    (a task of manisoft.tasks(), privileged state observations)"""
+                    first_index=0, action_mode="torque"|"ee_pose", action_repeat=36, render=False,
+                    camera=None) -> TaskVectorEnv
+                    (a task of manisoft.tasks(), privileged state observations; render=True adds the image)"""
     if name == "reach":
         return ReachVectorEnv(num_envs, num_threads, **kwargs)
     names = [t["name"] for t in tasks()]  # noqa: F821 (compiled function)

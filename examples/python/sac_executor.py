@@ -371,8 +371,11 @@ def distill(args):
     of --noise N m on every actuated entry (so that the samples show recoveries), iteration i > 0
     with the blend beta a_executor + (1 - beta) a_network, beta = 2^-i; every iteration records the
     model executor's action at the states visited, and the network is refitted on everything
-    recorded (squared torque error in units of the limits, through basis()). The checkpoint has the
-    trainer's layout, so `export` writes it and `train --init` starts SAC from it."""
+    recorded (squared torque error in units of the limits, through basis()). After every iteration
+    the network is evaluated on the held-out targets at the environment's horizon and written to
+    checkpoint.pt; best.pt keeps the iteration that reached the most of them (then held the most).
+    The checkpoints have the trainer's layout, so `export` writes them and `train --init` starts SAC
+    from one."""
     import torch
     import torch.nn as nn
     import manisoft
@@ -391,7 +394,8 @@ def distill(args):
     optimiser = torch.optim.Adam(sac.actor.parameters(), lr=args.lr)
     batches = np.random.default_rng(args.seed)
     inputs, labels, log, started = [], [], [], time.time()
-    eval_env = manisoft.make_vec_env("reach", args.eval_targets, num_threads=args.threads, horizon=args.horizon)
+    eval_env = manisoft.make_vec_env("reach", args.eval_targets, num_threads=args.threads)  # reach_eval's horizon
+    best = None
     for it in range(args.iterations):
         for k in range(args.targets):
             obs, _ = env.reset(seed=TRAIN_SEED_BASE + (args.seed << 32) + it * args.targets + k)
@@ -424,7 +428,7 @@ def distill(args):
                 optimiser.zero_grad()
                 loss.backward()
                 optimiser.step()
-        ev = evaluate(sac, eval_env, b, args.eval_seed, args.eval_targets, args.horizon)
+        ev = evaluate(sac, eval_env, b, args.eval_seed, args.eval_targets, eval_env.horizon)
         with torch.no_grad():
             fit = float((torch.tanh(sac.actor((x - sac.norm_mean) / sac.norm_scale)[:, :b.shape[1]]) @ b_t - y).pow(2).mean())
         log.append({"iteration": it + 1, "samples": len(x), "loss": fit, "zero_torque_loss": float(y.pow(2).mean()),
@@ -433,7 +437,11 @@ def distill(args):
         print(f"iteration {it + 1}: {len(x)} samples, loss {fit:.2e} (zero torques: {log[-1]['zero_torque_loss']:.2e}), "
               f"{log[-1]['seconds']:.0f} s, eval success {ev[0]:.2f} "
               f"reached {ev[1]:.2f} (|d_p| {ev[2]:.3f} m, |d_r| {ev[3]:.3f} rad)", flush=True)
-    save_atomic(torch, {"sac": sac.state(), "log": log, "args": vars(args), "distilled": True}, os.path.join(args.out, "checkpoint.pt"))
+        state = {"sac": sac.state(), "log": log, "args": vars(args), "distilled": True, "iteration": it + 1}
+        save_atomic(torch, state, os.path.join(args.out, "checkpoint.pt"))
+        if best is None or (ev[1], ev[0]) > best:  # the iteration that reaches most held-out targets (then holds most)
+            best = (ev[1], ev[0])
+            save_atomic(torch, state, os.path.join(args.out, "best.pt"))
 
 
 def export(args):

@@ -113,6 +113,10 @@ class BadInputs(unittest.TestCase):
         vec_ee.close()
         self.refused('make_vec_env("COLL", 2, action_mode="ee_pose", action_repeat=0)',
                      lambda: manisoft.make_vec_env("COLL", 2, action_mode="ee_pose", action_repeat=0), ValueError, "action_repeat = 0")
+        self.refused('make_vec_env("COLL", 2, camera={"width": 64})', lambda: manisoft.make_vec_env("COLL", 2, camera={"width": 64}),
+                     ValueError, "render=False")
+        self.refused('make_vec_env("COLL", 2, render=True, camera={"width": 0})',
+                     lambda: manisoft.make_vec_env("COLL", 2, render=True, camera={"width": 0}), ValueError, "width")
         self.evaluate_flags()
         failures = []
         TABLE.finish(failures)

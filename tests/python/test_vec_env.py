@@ -2,7 +2,8 @@
 bit-identical to make_env("reach") with the same seeds and actions at 1 and 2 threads, reset
 masks, Gymnasium's NEXT_STEP autoreset, bad actions refused with nothing changed; each task arm
 bit-identical to make_env(task, render=False, privileged=True) on the same scene, on the torque
-and the end-effector tracks, autoreset at the horizon; and the spaces' sample / contains.
+and the end-effector tracks, autoreset at the horizon, the camera images against the single
+environment's; and the spaces' sample / contains.
 Run: PYTHONPATH=<build>/python python3 -m unittest test_vec_env."""
 import unittest
 
@@ -356,6 +357,42 @@ class TaskVecAgainstSingle(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "action_mode = 'joint' must be 'torque' or 'ee_pose'"):
             manisoft.make_vec_env("COLL", 1, action_mode="joint")
         vec.close()
+
+    def test_images_against_singles(self):
+        """render=True: each arm's camera image equals make_env(task, render=True) in the same state,
+        pixel for pixel, after the reset, after end-effector commands and after one arm is reset to
+        another scene; two threads with three arms, so one worker draws one arm (incremental frames)
+        and the other switches between two arms' scenes."""
+        camera = {"width": 64, "height": 48}
+        vec = manisoft.make_vec_env("ALN", B, num_threads=2, seed=0, action_mode="ee_pose", action_repeat=12, render=True, camera=camera)
+        self.assertEqual(vec.single_observation_space["image"].shape, (48, 64, 3))
+        singles = [manisoft.make_env("ALN", "clean", seed=0, camera=camera, action_mode="ee_pose", action_repeat=12) for _ in range(B)]
+        obs, _ = vec.reset(seed=2)
+        s_obs = [env.reset(options={"index": 2 + i})[0] for i, env in enumerate(singles)]
+
+        def assert_images(obs, s_obs):
+            self.assertEqual((obs["image"].shape, obs["image"].dtype, obs["image"].flags.writeable), ((B, 48, 64, 3), np.uint8, False))
+            for i in range(B):
+                self.assertTrue(np.array_equal(obs["image"][i], s_obs[i]["image"]), f"arm {i}")
+                self.assertTrue(vec.single_observation_space["image"].contains(obs["image"][i]))
+
+        assert_images(obs, s_obs)
+        first = np.array(obs["image"])
+        home = np.array(obs["end_effector"][:, :3, 3])
+        rng = np.random.default_rng(5)
+        for k in range(4):
+            a = np.zeros((B, 7))
+            a[:, :3] = home + rng.normal(scale=0.08, size=(B, 3))
+            obs = vec.step(a)[0]
+            s_obs = [env.step(a[i])[0] for i, env in enumerate(singles)]
+            assert_images(obs, s_obs)
+        self.assertFalse(np.array_equal(first, obs["image"]))  # the arms moved
+        obs, _ = vec.reset(seed=[0, 9, 0], options={"reset_mask": np.array([False, True, False])})
+        s_obs[1] = singles[1].reset(options={"index": 9})[0]
+        assert_images(obs, s_obs)
+        vec.close()
+        with self.assertRaisesRegex(ValueError, "camera is given but render=False"):
+            manisoft.make_vec_env("ALN", 1, camera=camera)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 // BatchedTaskEnv: B task environments (task_env.hpp) of one task and setting, stepped by one call
 // over a persistent pool of threads (core/worker_pool.hpp), with the arms' state, rewards, flags
 // and infos in batch arrays a binding hands to numpy without a copy: batched evaluation, data
-// generation and learners of the state track (no images: a renderer per worker is not built here).
+// generation and learners of the state track; task/batched_task_images.hpp adds the camera images
+// (a renderer per worker, through the arm observer).
 //
 //   BatchedTaskEnv batch(B, threads, {scene::Task::aln, scene::Setting::clean});
 //   batch.reset(indices);                     // arm i: the scene (task, setting, split, indices[i], seed)
@@ -47,6 +48,9 @@
 // whatever the thread count and the arm's position in the batch.
 // Bad input (wrong sizes, a non-finite action of an arm that steps) is refused with InvalidInput
 // naming the arm and the entry before any arm changes.
+// Arm observer (set_observer): called on the worker thread that reset or stepped arm i, right after
+// its arrays were written, so that per-worker work on the arm (a frame of its camera) runs in
+// parallel as the physics does; its exceptions reach the caller of reset() or step().
 #pragma once
 
 #include <Eigen/Core>
@@ -54,6 +58,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -111,6 +116,21 @@ class BatchedTaskEnv {
   const TaskEnv& arm(int i) const { return *arms_.at(std::size_t(i)); }
   /// The canonical instruction of arm i's current scene.
   const std::string& instruction(int i) const { return specs_.at(std::size_t(i)).instruction; }
+  /// Arm i's current scene.
+  const scene::SceneSpec& scene(int i) const { return specs_.at(std::size_t(i)); }
+
+  /// observer(part, i, reset) after arm i's arrays were written by a reset (reset = true) or a step,
+  /// on the worker thread `part` that ran it (see the header comment). Replaces any earlier one.
+  using ArmObserver = std::function<void(int part, std::size_t arm, bool reset)>;
+  void set_observer(ArmObserver observer) { observer_ = std::move(observer); }
+
+  /// Calls f(part) once on each of the pool's threads (part 0: the caller's), e.g. to release what
+  /// an observer keeps per worker thread on that thread.
+  template <typename F>
+  void for_each_part(F&& f) {
+    auto job = [&f](int part, int) { f(part); };
+    pool_.run(job, pool_.threads());
+  }
 
   /// Starts a new episode on every arm, arm i on the scene of indices[i].
   void reset(std::span<const std::uint64_t> indices) {
@@ -195,13 +215,6 @@ class BatchedTaskEnv {
 
   std::size_t chunk_begin(int part, int parts) const { return arms_.size() * std::size_t(part) / std::size_t(parts); }
 
-  /// Calls f(part) once on each of the pool's threads.
-  template <typename F>
-  void for_each_part(F&& f) {
-    auto job = [&f](int part, int) { f(part); };
-    pool_.run(job, pool_.threads());
-  }
-
   /// Calls f(part, i) for every arm i over the pool: each thread (part) takes a contiguous chunk.
   template <typename F>
   void for_each_arm(F&& f) {
@@ -235,6 +248,7 @@ class BatchedTaskEnv {
     ee_command_[i] = control_steps_[i] = 0;
     write(i);
     pending_reset_[i] = terminated_[i];  // a scene that is no task (scene_invalid) is replaced at the next step
+    if (observer_) observer_(part, i, true);
   }
 
   void step_arm(int part, std::size_t i, std::span<const double> actions) {
@@ -260,6 +274,7 @@ class BatchedTaskEnv {
     }
     write(i);
     pending_reset_[i] = terminated_[i] || truncated_[i];
+    if (observer_) observer_(part, i, false);
   }
 
   static void write_pose(double* out, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& position) {
@@ -305,6 +320,7 @@ class BatchedTaskEnv {
   std::vector<std::unique_ptr<EndEffectorTrack>> tracks_;  ///< the end-effector track's, else null
   std::vector<scene::SceneSpec> specs_;
   std::vector<TaskEnv::Array3> torques_;
+  ArmObserver observer_;
   int n_ = 0;
   bool started_ = false;
   std::vector<double> rod_nodes_, end_effector_, gripper_pose_, gripper_width_, object_poses_, rewards_;
