@@ -81,6 +81,12 @@ class SacExecutorTest(unittest.TestCase):
         # noisy episodes, and closer on the blended DAgger episodes' states too
         self.assertLess(log[0]["loss"], 0.1 * log[0]["zero_torque_loss"])
         self.assertLess(log[1]["loss"], 0.5 * log[1]["zero_torque_loss"])
+        best = torch.load(os.path.join(out, "best.pt"))  # the iteration that reached most held-out targets, the first of equals
+        scores = [(e["eval_reached"], e["eval_success"]) for e in log]
+        self.assertEqual(best["iteration"], 1 + scores.index(max(scores)))
+        sac_executor.main(["curves", os.path.join(out, "curves.png"), out])
+        with open(os.path.join(out, "curves.png"), "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
         sac_executor.main(["export", os.path.join(out, "checkpoint.pt"), os.path.join(out, "executor.mlp")])
         self.assertEqual(manisoft.MlpExecutor(os.path.join(out, "executor.mlp")).act(manisoft.make_env("reach").reset(seed=1)[0]).shape, (20, 3))
         tuned = train(os.path.join(self.dir.name, "tuned"), "--rounds", "1", "--init", os.path.join(out, "checkpoint.pt"), "--hidden", "32", "32",
