@@ -1,7 +1,7 @@
 // BatchedTaskImages: the camera image of every arm of a task::BatchedTaskEnv (the image V_t a policy
-// sees, ManiSoft paper section 3.2), drawn on the batch's own worker threads by one renderer per
-// worker: each arm's frame is rendered right after its reset or step, on the thread that ran it
-// (BatchedTaskEnv's arm observer), so the frames are drawn in parallel as the physics is.
+// sees, ManiSoft paper section 3.2), drawn on the batch's own worker threads: each arm's frame is
+// rendered right after its reset or step, on the thread that ran it (BatchedTaskEnv's arm
+// observer), so the frames are drawn in parallel as the physics is.
 //
 //   BatchedTaskEnv batch(B, threads, settings);
 //   BatchedTaskImages images(batch, 128, 128);   // before the first reset; each scene's camera at 128 x 128
@@ -9,16 +9,17 @@
 //   images.images()                              // B x H x W x 3 uint8, row-major, top row first
 //
 // Camera: unset, each scene's own first camera at width x height; set, that camera (its width and
-// height replaced) for every scene. Each arm keeps its scene's render description, built at its
-// reset. A worker's renderer uploads an arm's scene when it draws another arm than the last (or a
-// new episode of it); otherwise it redraws only what changed (GlRendererOptions::incremental), so
-// with one arm per worker every frame of an episode is incremental. Either way an arm's pixels
-// are those of a renderer drawing that arm alone (a frame redrawn in part equals a full redraw,
-// pixel for pixel), the same as the single environment's image of the same state.
-// The renderers' EGL contexts are made on, and stay bound to, the threads that first draw: part 0
-// runs on the caller's thread, so reset and step the batch from one thread once it renders. Needs
-// the component manisoft::render (EGL, OpenGL); a renderer that cannot be made throws from the
-// reset that first draws, naming the cause.
+// height replaced) for every scene. Every arm has its own renderer (its own EGL context, as a
+// single environment's), made on the worker thread that first draws the arm (an arm always runs
+// on the same worker) and holding the arm's scene from its reset on, so every frame of an episode
+// redraws only what changed (GlRendererOptions::incremental); one renderer per worker would
+// re-upload a scene at every frame of a worker with several arms, which measured slower
+// (BENCHMARKS.md). An arm's pixels are those of a renderer drawing that arm alone, the same as the
+// single environment's image of the same state.
+// The contexts stay bound to the threads that made them: part 0 runs on the caller's thread, so
+// reset and step the batch from one thread once it renders. Needs the component manisoft::render
+// (EGL, OpenGL); a renderer that cannot be made throws from the reset that first draws, naming
+// the cause.
 #pragma once
 
 #include <algorithm>
@@ -49,19 +50,19 @@ class BasicBatchedTaskImages {
       camera_->height = height;
       render::validate(*camera_);
     }
-    const auto b = std::size_t(batch.batch_size()), parts = std::size_t(batch.threads());
-    images_.assign(b * frame_bytes(), 0);
-    scenes_.resize(b);
-    generation_.assign(b, 0);
-    workers_.resize(parts);
-    batch.set_observer([this](int part, std::size_t i, bool reset) { draw(std::size_t(part), i, reset); });
+    images_.assign(std::size_t(batch.batch_size()) * frame_bytes(), 0);
+    arms_.resize(std::size_t(batch.batch_size()));
+    batch.set_observer([this](int part, std::size_t i, bool reset) { draw(part, i, reset); });
   }
   BasicBatchedTaskImages(const BasicBatchedTaskImages&) = delete;
   BasicBatchedTaskImages& operator=(const BasicBatchedTaskImages&) = delete;
   ~BasicBatchedTaskImages() {
     batch_->set_observer(nullptr);
     try {  // each renderer released on the thread its context is current on
-      batch_->for_each_part([this](int part) { workers_[std::size_t(part)].renderer.reset(); });
+      batch_->for_each_part([this](int part) {
+        for (Arm& arm : arms_)
+          if (arm.part == part) arm.renderer.reset();
+      });
     } catch (...) {  // what a renderer's release throws: the rest are released below
     }
   }
@@ -72,51 +73,47 @@ class BasicBatchedTaskImages {
   std::span<const std::uint8_t> images() const { return images_; }
 
  private:
-  struct Worker {
-    std::unique_ptr<R> renderer;  ///< made on the worker's thread at its first frame
-    std::size_t arm = 0;          ///< the arm whose scene the renderer holds
-    std::uint64_t generation = 0; ///< and that arm's episode (0: none yet)
+  struct Arm {
+    std::unique_ptr<R> renderer;  ///< made on the worker thread that first draws the arm
+    int part = -1;                ///< that worker
+    render::tabletop::TabletopScene scene;  ///< the arm's current scene, built at its reset
     render::RenderOutput out;
     std::vector<math::Pose<double>> objects;
   };
 
   std::size_t frame_bytes() const { return std::size_t(width_) * std::size_t(height_) * 3; }
 
-  void draw(std::size_t part, std::size_t i, bool reset) {
+  void draw(int part, std::size_t i, bool reset) {
     const TaskEnv& env = batch_->arm(int(i));
+    Arm& arm = arms_[i];
+    if (!arm.renderer) {
+      arm.renderer = render::make_colour_renderer<R>();
+      arm.part = part;
+    }
     if (reset) {
-      scenes_[i] = scene::make_render_scene(batch_->scene(int(i)), env.library());
-      render::Camera camera = camera_ ? *camera_ : scenes_[i].scene.cameras.front();
+      arm.scene = scene::make_render_scene(batch_->scene(int(i)), env.library());
+      render::Camera camera = camera_ ? *camera_ : arm.scene.scene.cameras.front();
       camera.width = width_;
       camera.height = height_;
-      scenes_[i].scene.cameras = {camera};
-      ++generation_[i];
-    }
-    Worker& w = workers_[part];
-    if (!w.renderer) w.renderer = render::make_colour_renderer<R>();
-    if (w.arm != i || w.generation != generation_[i]) {
-      w.renderer->set_scene(scenes_[i].scene);
-      w.arm = i;
-      w.generation = generation_[i];
+      arm.scene.scene.cameras = {camera};
+      arm.renderer->set_scene(arm.scene.scene);
     }
     const auto& world = env.world();
     const math::Pose<double> gripper{world.rigid().orientation(world.gripper_body()).toRotationMatrix(), world.rigid().position(world.gripper_body())};
-    w.objects.clear();
-    for (const auto& o : env.snapshot().objects) w.objects.push_back(o.pose);
-    const render::FrameState frame = scene::render_frame(scenes_[i], world.rod().state().positions, gripper, world.gripper().finger_width(), w.objects);
-    w.renderer->render_into(frame, w.out);
-    if (w.out.rgb.size() != frame_bytes())
-      manisoft::detail::fail("BatchedTaskImages: arm ", i, "'s frame holds ", w.out.rgb.size(), " bytes, expected ", frame_bytes());
-    std::copy(w.out.rgb.begin(), w.out.rgb.end(), images_.begin() + std::ptrdiff_t(i * frame_bytes()));
+    arm.objects.clear();
+    for (const auto& o : env.snapshot().objects) arm.objects.push_back(o.pose);
+    const render::FrameState frame = scene::render_frame(arm.scene, world.rod().state().positions, gripper, world.gripper().finger_width(), arm.objects);
+    arm.renderer->render_into(frame, arm.out);
+    if (arm.out.rgb.size() != frame_bytes())
+      manisoft::detail::fail("BatchedTaskImages: arm ", i, "'s frame holds ", arm.out.rgb.size(), " bytes, expected ", frame_bytes());
+    std::copy(arm.out.rgb.begin(), arm.out.rgb.end(), images_.begin() + std::ptrdiff_t(i * frame_bytes()));
   }
 
   BatchedTaskEnv* batch_;
   int width_, height_;
   std::optional<render::Camera> camera_;
   std::vector<std::uint8_t> images_;
-  std::vector<render::tabletop::TabletopScene> scenes_;
-  std::vector<std::uint64_t> generation_;
-  std::vector<Worker> workers_;
+  std::vector<Arm> arms_;
 };
 
 /// The images drawn with the in-process OpenGL renderer (OpenGL through EGL).
