@@ -443,7 +443,7 @@ class TaskVectorEnv(_VectorEnv):
     gripper_width (B), gripper_state (B), object_poses (B x K x 4 x 4: the first object_count[i]
     are arm i's objects, the others zero), object_count (B), instruction (a tuple of B str);
     render=True: image (B x H x W x 3 uint8), each arm's camera image drawn on the worker thread
-    that stepped it (one renderer per thread), the pixels make_env(..., render=True, camera=camera)
+    that stepped it (a renderer per arm), the pixels make_env(..., render=True, camera=camera)
     gives in the same state; camera: as make_env's (a dict replacing each scene's camera; None:
     each scene's own at 514 x 514). A rendering environment is used from the thread of its first
     reset.

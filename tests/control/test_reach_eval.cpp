@@ -140,9 +140,9 @@ TEST_CASE("reach_eval refuses bad flags and malformed weight files", "[executor]
 TEST_CASE("the shipped MLP executor reaches the share of the table targets BENCHMARKS.md documents", "[executor][mlp][reach_eval]") {
   // examples/data/executors/distilled_table.mlp (manisoft.sac_executor distill, exported) on
   // reach_eval's 100 table targets of seed 1: within 0.03 m / 0.3 rad once (--hold-steps 1, the
-  // paper's criterion) on 10, held 100 control steps on 1 (a g++ -O2 build). The closed loop is
-  // sensitive to the last bits of the network's sums, which differ between optimisation levels
-  // and compilers: a band of two targets either way.
+  // paper's criterion) on 71, held 100 control steps on 14 (g++ -O1, -O2 and -O3 builds). The closed
+  // loop is sensitive to the last bits of the network's sums, which may differ between
+  // optimisation levels and compilers: a band of five targets either way (four for the held).
   const std::string weights = MANISOFT_TEST_DATA_DIR "/../../examples/data/executors/distilled_table.mlp";
   const std::string out = scratch + "/shipped.csv";
   const auto successes = [&](int hold_steps) {
@@ -154,7 +154,9 @@ TEST_CASE("the shipped MLP executor reaches the share of the table targets BENCH
     return std::count_if(rows.begin(), rows.end(), [](const auto& row) { return row.at(success_column) == 1.0; });
   };
   const auto reached = successes(1);
-  CHECK(reached >= 8);
-  CHECK(reached <= 12);
-  CHECK(successes(100) <= 3);
+  CHECK(reached >= 66);
+  CHECK(reached <= 76);
+  const auto held = successes(100);
+  CHECK(held >= 10);
+  CHECK(held <= 18);
 }

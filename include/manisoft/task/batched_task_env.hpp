@@ -2,7 +2,7 @@
 // over a persistent pool of threads (core/worker_pool.hpp), with the arms' state, rewards, flags
 // and infos in batch arrays a binding hands to numpy without a copy: batched evaluation, data
 // generation and learners of the state track; task/batched_task_images.hpp adds the camera images
-// (a renderer per worker, through the arm observer).
+// (a renderer per arm, drawn on its worker thread through the arm observer).
 //
 //   BatchedTaskEnv batch(B, threads, {scene::Task::aln, scene::Setting::clean});
 //   batch.reset(indices);                     // arm i: the scene (task, setting, split, indices[i], seed)
