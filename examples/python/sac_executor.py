@@ -113,6 +113,16 @@ class Sac:
         self.norm_mean = torch.zeros(obs_size)
         self.norm_scale = torch.ones(obs_size)
         self.generator = torch.Generator().manual_seed(args.seed)
+        self.anchor = None  # set_anchor(): a frozen copy of the actor that the actor is held near
+
+    def set_anchor(self):
+        """Freezes a copy of the current actor: from now on the actor's loss is normalised by the
+        critics' scale and adds --anchor x the squared distance of its deterministic action from the
+        copy's (as TD3+BC holds a policy near its data), so that post-training stays near the start."""
+        import copy
+        self.anchor = copy.deepcopy(self.actor)
+        for p in self.anchor.parameters():
+            p.requires_grad_(False)
 
     def policy(self, obs):
         """Squashed sample, its log-probability, and the deterministic action tanh(mean)."""
@@ -150,9 +160,13 @@ class Sac:
             return float(critic_loss), 0.0, float(alpha)
         for p in self.critics.parameters():
             p.requires_grad_(False)
-        new_u, logp, _ = self.policy(obs)
-        q1, q2 = self.q(self.critics, obs, new_u)
-        actor_loss = (alpha * logp - torch.min(q1, q2)).mean()
+        new_u, logp, mean_u = self.policy(obs)
+        q = torch.min(*self.q(self.critics, obs, new_u))
+        actor_loss = (alpha * logp - q).mean()
+        if self.anchor is not None:
+            with torch.no_grad():
+                start = torch.tanh(self.anchor((obs - self.norm_mean) / self.norm_scale)[:, :self.act_size])
+            actor_loss = actor_loss / q.abs().mean().detach().clamp(min=1e-6) + a.anchor * (mean_u - start).pow(2).sum(1).mean()
         self.actor_opt.zero_grad()
         actor_loss.backward()
         self.actor_opt.step()
@@ -174,7 +188,8 @@ class Sac:
         return {"actor": self.actor.state_dict(), "critics": self.critics.state_dict(), "targets": self.targets.state_dict(),
                 "log_alpha": self.log_alpha.detach().clone(), "actor_opt": self.actor_opt.state_dict(),
                 "critic_opt": self.critic_opt.state_dict(), "alpha_opt": self.alpha_opt.state_dict(),
-                "norm_mean": self.norm_mean, "norm_scale": self.norm_scale, "generator": self.generator.get_state()}
+                "norm_mean": self.norm_mean, "norm_scale": self.norm_scale, "generator": self.generator.get_state(),
+                "anchor": None if self.anchor is None else self.anchor.state_dict()}
 
     def load(self, s, weights_only=False):
         self.actor.load_state_dict(s["actor"])
@@ -189,6 +204,9 @@ class Sac:
         self.critic_opt.load_state_dict(s["critic_opt"])
         self.alpha_opt.load_state_dict(s["alpha_opt"])
         self.generator.set_state(s["generator"])
+        if s.get("anchor") is not None:
+            self.set_anchor()
+            self.anchor.load_state_dict(s["anchor"])
 
 
 class Replay:
@@ -266,6 +284,8 @@ def train(args):
     if horizon % args.repeat:
         sys.exit(f"--repeat {args.repeat} must divide the horizon {horizon}")
     decisions = horizon // args.repeat
+    if args.anchor > 0 and not args.init:
+        sys.exit("--anchor holds the actor near an --init policy: give --init")
     obs, _ = env.reset(seed=TRAIN_SEED_BASE)
     obs_size, act_size = features(obs).shape[1], b.shape[1]
     sac = Sac(torch, nn, obs_size, act_size, args)
@@ -288,6 +308,8 @@ def train(args):
                 head.bias[act_size:].fill_(args.init_log_std)
         with torch.no_grad():
             sac.log_alpha.fill_(math.log(args.init_alpha))
+        if args.anchor > 0:
+            sac.set_anchor()
         print(f"initialised from {args.init}", flush=True)
     eval_env = manisoft.make_vec_env("reach", args.eval_targets, num_threads=args.threads, horizon=args.horizon,
                                      stability_beta=args.stability_beta)
@@ -486,7 +508,7 @@ def curves(args):
     import matplotlib.pyplot as plt
 
     import torch
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.8), sharey=True)
     for run in args.runs:
         log = [e for e in torch.load(os.path.join(run, "checkpoint.pt"))["log"] if "eval_success" in e]
         minutes = [e["seconds"] / 60 for e in log]
@@ -501,9 +523,10 @@ def curves(args):
         ax.set_ylim(-2, 100)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("% of the held-out table targets (reach_eval seed 7)")
-    axes[1].legend(loc="upper right", fontsize=8)
+    handles, labels = axes[1].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8)
     fig.suptitle("Learned executors on the reach benchmark (deterministic policy, a decision every control step)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.1, 1, 1))
     fig.savefig(args.out, dpi=110)
     print(f"wrote {args.out}")
 
@@ -521,6 +544,9 @@ def main(argv=None):
     t.add_argument("--init-log-std", type=float, help="with --init: the actor's log standard deviation, fixed to this at the start")
     t.add_argument("--init-alpha", type=float, default=1.0, help="with --init: the entropy temperature to start from (default 1)")
     t.add_argument("--actor-delay", type=int, default=0, help="updates of the critics alone before the actor learns (default 0)")
+    t.add_argument("--anchor", type=float, default=0.0,
+                   help="with --init: hold the actor near the initial one, this weight on the squared distance of their actions "
+                        "(the critic's term normalised by its scale, as TD3+BC; default 0: plain SAC)")
     t.add_argument("--envs", type=int, default=32, help="arms stepped together (default 32)")
     t.add_argument("--threads", type=int, default=2, help="environment threads (default 2)")
     t.add_argument("--torch-threads", type=int, default=1, help="PyTorch threads (default 1)")

@@ -89,9 +89,29 @@ class SacExecutorTest(unittest.TestCase):
             self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
         sac_executor.main(["export", os.path.join(out, "checkpoint.pt"), os.path.join(out, "executor.mlp")])
         self.assertEqual(manisoft.MlpExecutor(os.path.join(out, "executor.mlp")).act(manisoft.make_env("reach").reset(seed=1)[0]).shape, (20, 3))
-        tuned = train(os.path.join(self.dir.name, "tuned"), "--rounds", "1", "--init", os.path.join(out, "checkpoint.pt"), "--hidden", "32", "32",
-                      "--init-log-std", "-3", "--actor-delay", "3")
+        post = ("--rounds", "3", "--init", os.path.join(out, "checkpoint.pt"), "--hidden", "32", "32", "--init-log-std", "-3", "--actor-delay", "3")
+        tuned = train(os.path.join(self.dir.name, "tuned"), *post)
         self.assertGreater(tuned["updates"], 0)
+        # --anchor holds the post-trained actor near the clone: its deterministic actions move less
+        # than plain SAC's from the same start, seeds and updates
+        held = train(os.path.join(self.dir.name, "held"), *post, "--anchor", "1000")
+        self.assertIsNotNone(held["sac"]["anchor"])
+        import argparse
+        states = torch.from_numpy(sac_executor.features({k: np.stack([np.asarray(manisoft.make_env("reach").reset(seed=i)[0][k]) for i in range(8)])
+                                                         for k in ("target", "end_effector", "node_positions", "node_velocities")}).astype(np.float32))
+
+        def actions(checkpoint):
+            sac = sac_executor.Sac(torch, torch.nn, states.shape[1], 12, argparse.Namespace(**tuned["args"]))
+            sac.load(checkpoint["sac"], weights_only=True)
+            with torch.no_grad():
+                return sac.policy(states)[2]
+
+        start = actions(torch.load(os.path.join(out, "checkpoint.pt")))
+        moved_free, moved_held = (float((actions(c) - start).abs().max()) for c in (tuned, held))
+        self.assertGreater(moved_free, 0)
+        self.assertLess(moved_held, 0.5 * moved_free)
+        with self.assertRaises(SystemExit):
+            sac_executor.main(["train", "--out", os.path.join(self.dir.name, "bad"), *TINY, "--anchor", "1"])
 
     def test_stability_beta_switches_the_paper_stability_term(self):
         # The model executor's actions, replayed in batches with beta = 1 and beta = 0: the rewards
