@@ -14,7 +14,8 @@ reaches, and why SAC falls short of the paper's executor here: BENCHMARKS.md, "L
 Environment: manisoft.make_vec_env("reach", --envs) (every arm its own target of the table set;
 the paper's arm, 714 Hz control, horizon 1500 control steps). The reward is the environment's own
 (reward/distance_reward.hpp R_d plus reward/stability_reward.hpp R_s with beta = --stability-beta:
-the paper trains with R_d alone, then post-trains with R_s: --init a trained run's checkpoint).
+the paper trains with R_d alone, then post-trains with R_s: --init a trained run's checkpoint, and
+--anchor W to hold the actor near it).
 Observation (the paper's: target pose, current end-effector pose, positions and velocities of
 every second node of the arm): exactly the MLP executor's features (mlp_executor.hpp), normalised
 by a fixed affine map measured on the first round's states (it is folded into the exported
