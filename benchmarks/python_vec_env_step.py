@@ -11,7 +11,8 @@ table and the objects: each step has the rod, the gripper, the objects and their
 episode that ends (an object knocked off the table) resets within the timing, as a vector
 environment's autoreset does. --render W H adds the camera image of every arm at every step
 (make_env(TASK, render=True, camera=...) against make_vec_env(TASK, B, render=True, camera=...):
-one renderer per single environment against one per thread of the vector environment).
+a renderer per single environment against one per arm of the vector environment, drawn on its
+worker thread).
 Run: PYTHONPATH=build/<config>/python /usr/bin/python3 benchmarks/python_vec_env_step.py [--env ALN]
 """
 import argparse

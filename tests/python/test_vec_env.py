@@ -361,8 +361,8 @@ class TaskVecAgainstSingle(unittest.TestCase):
     def test_images_against_singles(self):
         """render=True: each arm's camera image equals make_env(task, render=True) in the same state,
         pixel for pixel, after the reset, after end-effector commands and after one arm is reset to
-        another scene; two threads with three arms, so one worker draws one arm (incremental frames)
-        and the other switches between two arms' scenes."""
+        another scene; two threads with three arms, so one worker draws one arm and the other draws
+        two, each with its own renderer (incremental frames)."""
         camera = {"width": 64, "height": 48}
         vec = manisoft.make_vec_env("ALN", B, num_threads=2, seed=0, action_mode="ee_pose", action_repeat=12, render=True, camera=camera)
         self.assertEqual(vec.single_observation_space["image"].shape, (48, 64, 3))
