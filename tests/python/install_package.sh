@@ -28,10 +28,10 @@ vec.reset(seed=0)
 assert vec.step(np.zeros(vec.action_space.shape))[0]["node_positions"].shape[0] == 2
 print("manisoft from", os.path.dirname(manisoft.__file__), ": an ALN step and a reach batch step")
 PY
-  for script in evaluate read_dataset export_zarr dataset_stats bc_baseline reference_policy sac_executor; do
+  for script in evaluate read_dataset export_zarr dataset_stats bc_baseline reference_policy image_policy sac_executor; do
     PYTHONPATH=$1 "$python" -m manisoft.$script --help > /dev/null || { echo "python3 -m manisoft.$script --help failed"; exit 1; }
   done
-  echo "python3 -m manisoft.{evaluate,read_dataset,export_zarr,dataset_stats,bc_baseline,reference_policy,sac_executor} --help: OK"
+  echo "python3 -m manisoft.{evaluate,read_dataset,export_zarr,dataset_stats,bc_baseline,reference_policy,image_policy,sac_executor} --help: OK"
 }
 
 cmake --install "$build" --component python --prefix "$scratch/prefix" > /dev/null

@@ -1,0 +1,431 @@
+#!/usr/bin/env python3
+"""The reference policy from the image and the instruction on the end-effector track: a perception
+network (a small CNN trained from scratch, the instruction embedded) reads off the camera image
+what the privileged reference policy (reference_policy.py) reads from the state, and that policy's
+trained model acts on it. It sees what the paper's policies see, the image and the instruction,
+plus its own previous commands.
+
+    generate_dataset --tasks ALN,COLL --clean 1000 --randomized 1000 --seed 1 --out data/ref2
+    render_dataset data/ref2 --out img/ref2 --every 36 --image-size 192 192
+    /usr/bin/python3 -m manisoft.image_policy train --data data/ref2:img/ref2 --tasks ALN,COLL --out img/models
+    MANISOFT_REFERENCE_MODELS=ref/models MANISOFT_PERCEPTION_MODELS=img/models /usr/bin/python3 -m manisoft.evaluate \\
+        --task ALN --setting all --policy python:manisoft.image_policy:act --action-mode ee_pose --image-size 192 192 --out img/eval
+
+Perception: the image's table region (CROP, fractions of the image) at 96 x 96 pixels with two
+coordinate channels; four convolutions, the instruction's words (a bag of embeddings) scaling and
+shifting the third one's channels (FiLM); 64 keypoints (the spatial softmax's expected image
+coordinates of the third one's channels), the fourth one's mean and the instruction embedding into
+an MLP. It answers, in the world frame: the end effector's position and rotation and the finger
+width; the moved object's position and rotation; the second pose of the goal (COLL: the
+container; ALN, OVR: the goal marker); OVR's obstacle's position; and the moved object's asset (a
+class). Trained on frames rendered from the dataset's episodes (render_dataset --every K) with the
+episode's recorded state as labels: squared errors in units of PERCEPTION_SCALES, cross-entropy of
+the asset; each frame's instruction is drawn from the episode's canonical and seen ones, a word
+dropped at random (unseen paraphrases use words training never saw).
+Acting: the static parts of the scene (the container or goal, the obstacle, the asset) are averaged
+over the episode's frames so far; the end effector, the fingers and the moved object are read from
+the current frame; S is the policy's own last command. The task is the one whose training
+instructions make the instruction's words likeliest (naive Bayes over the words).
+"""
+import argparse
+import glob
+import json
+import os
+import re
+import sys
+import time
+
+import numpy as np
+
+try:  # python3 -m manisoft.image_policy, or the script beside reference_policy.py
+    from . import reference_policy as rp
+except ImportError:
+    import reference_policy as rp
+
+CROP = (0.25, 0.28125, 0.75, 0.78125)  # left, top, right, bottom: the table and the space above it
+SIZE = 96  # the crop's pixels a side
+KEYPOINTS = 64
+# the answer vector: (first column, length, unit of its error in the loss)
+FIELDS = {"ee_position": (0, 3, 0.01), "ee_rotation": (3, 6, 0.05), "width": (9, 1, 0.005),
+          "object_position": (10, 3, 0.01), "object_rotation": (13, 6, 0.05),
+          "second_position": (19, 3, 0.01), "second_rotation": (22, 6, 0.05), "obstacle": (28, 3, 0.01)}
+ANSWER = 31
+STATIC = ("second_position", "second_rotation", "obstacle")
+
+
+def words(text):
+    return re.findall(r"[a-z0-9']+", text.lower())
+
+
+def crop(image):
+    """The image's CROP region at SIZE x SIZE (uint8 H x W x 3 -> uint8 SIZE x SIZE x 3), by area
+    averaging when the region is larger."""
+    h, w = image.shape[:2]
+    x0, y0, x1, y1 = (int(round(f * s)) for f, s in zip(CROP, (w, h, w, h)))
+    region = image[y0:y1, x0:x1]
+    if region.shape[:2] == (SIZE, SIZE):
+        return np.ascontiguousarray(region)
+    ry, rx = region.shape[0] / SIZE, region.shape[1] / SIZE
+    if ry == int(ry) and rx == int(rx) and ry >= 1:
+        r = region.reshape(SIZE, int(ry), SIZE, int(rx), 3).astype(np.float32).mean((1, 3))
+        return np.round(r).astype(np.uint8)
+    raise ValueError(f"image_policy: a {w} x {h} image's crop is {region.shape[1]} x {region.shape[0]}, "
+                     f"not {SIZE} x {SIZE} or a whole multiple of it (use --image-size 192 192 or 384 384)")
+
+
+# ---- the dataset: frames and their labels
+
+def labels_of(scene, eef, grip, objects):
+    """The answer vector of one recorded step (eef: 7, grip: 2, objects: k x 7) and the asset."""
+    roles = rp.SceneRoles(scene)
+    y = np.zeros(ANSWER)
+    y[0:3], y[3:9], y[9] = eef[:3], rp.six(rp.rotation_of_quaternion(eef[3:])), grip[0]
+    moved = objects[roles.roles[0]]
+    y[10:13], y[13:19] = moved[:3], rp.six(rp.rotation_of_quaternion(moved[3:]))
+    if scene["task"] == "COLL":
+        c = objects[roles.roles[1]]
+        y[19:22], y[22:28] = c[:3], rp.six(rp.rotation_of_quaternion(c[3:]))
+    else:
+        y[19:22], y[22:28] = roles.goal[0], rp.six(roles.goal[1])
+    y[28:31] = roles.obstacle
+    return y, roles.asset
+
+
+def read_frames(pairs, task):
+    """Every rendered frame of the task's episodes: per mask (train, valid) the crops (N x SIZE x
+    SIZE x 3 uint8), the answers (N x ANSWER), the assets and the episode's instructions."""
+    import h5py
+    out = {m: {"images": [], "answers": [], "assets": [], "instructions": []} for m in ("train", "valid")}
+    for pair in pairs:
+        data, images = pair.split(":", 1)
+        with h5py.File(os.path.join(data, "dataset.hdf5"), "r") as index:
+            masks = {name: {m.decode() for m in index["mask"][name][()]} for name in ("train", "valid")}
+            for path in sorted(glob.glob(os.path.join(images, "demo_*.hdf5"))):
+                demo = os.path.basename(path)[:-len(".hdf5")]
+                g = index["data"][demo]
+                if g.attrs["task"] != task:
+                    continue
+                with h5py.File(path, "r") as f:
+                    frames = f["data"][demo]["images"]["agentview_image"][()]
+                    steps = f["data"][demo]["images"]["agentview_image_steps"][()]
+                scene = json.loads(g.attrs["scene"])
+                eef, grip, obj = (g["obs"][k][()].astype(np.float64) for k in ("eef_pose", "gripper", "object_poses"))
+                obj = obj.reshape(len(obj), -1, 7)
+                said = [str(g.attrs["instruction"])] + json.loads(g.attrs["instructions_seen"])
+                m = out["train" if demo in masks["train"] else "valid"]
+                for frame, step in zip(frames, steps):
+                    y, asset = labels_of(scene, eef[step], grip[step], obj[step])
+                    m["images"].append(crop(frame))
+                    m["answers"].append(y)
+                    m["assets"].append(asset)
+                    m["instructions"].append(said)
+    return out
+
+
+# ---- the network
+
+def build_model(torch, vocabulary, assets):
+    nn = torch.nn
+
+    class Perception(nn.Module):
+        def __init__(self):
+            super().__init__()
+            self.c1, self.c2 = nn.Conv2d(5, 16, 5, 2, 2), nn.Conv2d(16, 32, 3, 2, 1)
+            self.c3, self.c4 = nn.Conv2d(32, KEYPOINTS, 3, 1, 1), nn.Conv2d(KEYPOINTS, 64, 3, 2, 1)
+            self.words = nn.EmbeddingBag(vocabulary + 1, 32, mode="mean")  # index 0: a word training never saw
+            self.film = nn.Linear(32, 2 * KEYPOINTS)
+            self.head = nn.Sequential(nn.Linear(2 * KEYPOINTS + 64 + 32, 256), nn.ReLU(), nn.Linear(256, 256), nn.ReLU(),
+                                      nn.Linear(256, ANSWER + assets))
+            grid = torch.linspace(-1.0, 1.0, SIZE)
+            self.register_buffer("coords", torch.stack(torch.meshgrid(grid, grid, indexing="ij"))[None])
+            half = torch.linspace(-1.0, 1.0, SIZE // 4)
+            self.register_buffer("kx", half[None, None, None, :].expand(1, 1, SIZE // 4, SIZE // 4).reshape(1, 1, -1))
+            self.register_buffer("ky", half[None, None, :, None].expand(1, 1, SIZE // 4, SIZE // 4).reshape(1, 1, -1))
+
+        def forward(self, images, tokens, offsets):
+            """images: N x SIZE x SIZE x 3 uint8; tokens, offsets: the instructions' word indices."""
+            x = images.permute(0, 3, 1, 2).float() / 255.0
+            x = torch.cat([x, self.coords.expand(len(x), -1, -1, -1)], 1).contiguous(memory_format=torch.channels_last)
+            x = torch.relu(self.c2(torch.relu(self.c1(x))))
+            e = self.words(tokens, offsets)
+            scale, shift = self.film(e).chunk(2, 1)
+            k = torch.relu(self.c3(x) * (1 + scale[:, :, None, None]) + shift[:, :, None, None])
+            soft = torch.softmax(k.flatten(2), 2)
+            points = torch.cat([(soft * self.kx).sum(2), (soft * self.ky).sum(2)], 1)
+            pooled = torch.relu(self.c4(k)).mean((2, 3))
+            return self.head(torch.cat([points, pooled, e], 1))
+
+    return Perception()
+
+
+def encode(torch, texts, vocabulary, drop=0.0, generator=None):
+    """Word indices (0 for unknown or dropped words) and offsets for EmbeddingBag."""
+    tokens, offsets = [], []
+    for text in texts:
+        offsets.append(len(tokens))
+        ids = [vocabulary.get(w, 0) for w in words(text)] or [0]
+        if drop > 0:
+            keep = torch.rand(len(ids), generator=generator).numpy() >= drop
+            ids = [i if k else 0 for i, k in zip(ids, keep)]
+        tokens.extend(ids)
+    return torch.tensor(tokens, dtype=torch.long), torch.tensor(offsets, dtype=torch.long)
+
+
+def loss_of(torch, out, answers, asset_ids, scales):
+    squared = ((out[:, :ANSWER] - answers) / scales) ** 2
+    return squared.mean() + torch.nn.functional.cross_entropy(out[:, ANSWER:], asset_ids)
+
+
+def errors_of(torch, out, answers):
+    """Mean absolute error per field (m for positions, width; 6D units for rotations)."""
+    return {name: float((out[:, c:c + n] - answers[:, c:c + n]).abs().mean()) for name, (c, n, _) in FIELDS.items()}
+
+
+def scales_of(torch):
+    s = np.zeros(ANSWER, dtype=np.float32)
+    for c, n, unit in FIELDS.values():
+        s[c:c + n] = unit
+    return torch.from_numpy(s)
+
+
+def train_task(args, task, torch):
+    path = os.path.join(args.out, f"{task}.perception.pt")
+    checkpoint = path + ".checkpoint"
+    data = read_frames(args.data, task)
+    train, valid = data["train"], data["valid"]
+    if not train["images"]:
+        raise ValueError(f"{', '.join(args.data)}: no rendered {task} frames of train-mask episodes")
+    assets = sorted(set(train["assets"]))
+    counts = {}
+    for said in train["instructions"][::1]:
+        for text in said:
+            for w in words(text):
+                counts[w] = counts.get(w, 0) + 1
+    vocabulary = {w: i + 1 for i, w in enumerate(sorted(counts))}
+    images = torch.from_numpy(np.stack(train["images"]))
+    answers = torch.from_numpy(np.asarray(train["answers"], dtype=np.float32))
+    asset_ids = torch.tensor([assets.index(a) for a in train["assets"]])
+    scales = scales_of(torch)
+    torch.manual_seed(args.seed)
+    model = build_model(torch, len(vocabulary), len(assets))
+    optimiser = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=1e-4)
+    generator = torch.Generator().manual_seed(args.seed)
+    epoch, history = 0, []
+    if args.resume and os.path.exists(checkpoint):
+        saved = torch.load(checkpoint)
+        model.load_state_dict(saved["model"])
+        optimiser.load_state_dict(saved["optimiser"])
+        generator.set_state(saved["generator"])
+        epoch, history = saved["epoch"], saved["history"]
+        print(f"{task}: resumed after epoch {epoch}", flush=True)
+    print(f"{task}: {len(images)} train / {len(valid['images'])} valid frames, {len(assets)} assets, "
+          f"{len(vocabulary)} words", flush=True)
+
+    def valid_pass():
+        if not valid["images"]:
+            return None, {}
+        vi, va = np.stack(valid["images"]), torch.from_numpy(np.asarray(valid["answers"], dtype=np.float32))
+        vid = torch.tensor([assets.index(a) if a in assets else 0 for a in valid["assets"]])
+        outs = []
+        with torch.no_grad():
+            for s in range(0, len(vi), 512):
+                tokens, offsets = encode(torch, [said[0] for said in valid["instructions"][s:s + 512]], vocabulary)
+                outs.append(model(torch.from_numpy(vi[s:s + 512]), tokens, offsets))
+        out = torch.cat(outs)
+        errors = errors_of(torch, out, va)
+        errors["asset_accuracy"] = float((out[:, ANSWER:].argmax(1) == vid).float().mean())
+        return loss_of(torch, out, va, vid, scales).item(), errors
+
+    t0 = time.perf_counter()
+    gamma = args.lr_decay ** (1.0 / max(args.epochs, 1))
+    stop = args.epochs if args.stop_after is None else min(args.epochs, epoch + args.stop_after)
+    while epoch < stop:
+        for group in optimiser.param_groups:
+            group["lr"] = args.lr * gamma ** epoch
+        model.train()
+        order = torch.randperm(len(images), generator=generator)
+        total = 0.0
+        for start in range(0, len(order), args.batch):
+            idx = order[start:start + args.batch]
+            pick = torch.randint(0, 1 << 30, (len(idx),), generator=generator)
+            texts = [train["instructions"][i][p % len(train["instructions"][i])] for i, p in zip(idx.tolist(), pick.tolist())]
+            tokens, offsets = encode(torch, texts, vocabulary, args.word_drop, generator)
+            loss = loss_of(torch, model(images[idx], tokens, offsets), answers[idx], asset_ids[idx], scales)
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+            total += loss.item() * len(idx)
+        epoch += 1
+        model.eval()
+        held_out, errors = valid_pass()
+        history.append((epoch, total / len(images), held_out, errors))
+        shown = "" if held_out is None else f", held-out loss {held_out:.3f} (" + ", ".join(
+            f"{k} {v * (100 if k.endswith(('position', 'width', 'obstacle')) else 1):.2f}" for k, v in errors.items()) + ")"
+        print(f"{task} epoch {epoch}/{args.epochs}: train loss {total / len(images):.3f}{shown}, "
+              f"{time.perf_counter() - t0:.0f} s", flush=True)
+        tmp = checkpoint + ".tmp"
+        torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(), "generator": generator.get_state(),
+                    "epoch": epoch, "history": history}, tmp)
+        os.replace(tmp, checkpoint)
+    if epoch < args.epochs:
+        print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
+        return None
+    tmp = path + ".tmp"
+    torch.save({"model": model.state_dict(), "vocabulary": vocabulary, "assets": assets, "task": task, "history": history,
+                "word_counts": counts}, tmp)
+    os.replace(tmp, path)
+    print(f"{task}: model -> {path}", flush=True)
+    return model
+
+
+def train(args):
+    import torch
+    torch.set_num_threads(args.threads)
+    for pair in args.data:
+        if ":" not in pair:
+            raise SystemExit(f"image_policy: --data {pair}: expected DATASET_DIR:IMAGES_DIR")
+    os.makedirs(args.out, exist_ok=True)
+    return {task: train_task(args, task, torch) for task in args.tasks.split(",")}
+
+
+# ---- acting (evaluate.py: python:manisoft.image_policy:act)
+
+class Perception:
+    """One task's perception model and the episode's running estimates of the static parts."""
+
+    def __init__(self, path, torch):
+        saved = torch.load(path)
+        self.torch, self.task = torch, saved["task"]
+        self.vocabulary, self.assets, self.counts = saved["vocabulary"], saved["assets"], saved["word_counts"]
+        self.model = build_model(torch, len(self.vocabulary), len(self.assets))
+        self.model.load_state_dict(saved["model"])
+        self.model.eval()
+        self.reset()
+
+    def reset(self):
+        self.static, self.asset_logits, self.frames = np.zeros(ANSWER), np.zeros(len(self.assets)), 0
+
+    def __call__(self, image, instruction):
+        """The answer for one image (its static fields averaged over the episode's frames) and the asset."""
+        torch = self.torch
+        tokens, offsets = encode(torch, [instruction], self.vocabulary)
+        with torch.no_grad():
+            out = self.model(torch.from_numpy(crop(np.asarray(image))[None]), tokens, offsets)[0].numpy().astype(np.float64)
+        self.frames += 1
+        self.static += (out[:ANSWER] - self.static) / self.frames
+        self.asset_logits += out[ANSWER:]
+        y = out[:ANSWER].copy()
+        for name in STATIC:
+            c, n, _ = FIELDS[name]
+            y[c:c + n] = self.static[c:c + n]
+        return y, self.assets[int(np.argmax(self.asset_logits))]
+
+def task_of(instruction, models):
+    """The task whose training instructions make the instruction's words likeliest: naive Bayes,
+    add-one smoothed over the words any task's training saw (the others tell no task apart)."""
+    vocabulary = set().union(*(m.counts for m in models.values()))
+    said = [w for w in words(instruction) if w in vocabulary]
+
+    def log_likelihood(m):
+        total = sum(m.counts.values()) + len(vocabulary)
+        return sum(np.log((m.counts.get(w, 0) + 1) / total) for w in said)
+    return max(sorted(models), key=lambda t: log_likelihood(models[t]))
+
+
+def rotation_of_six(v):
+    """The rotation whose first two columns are closest to v's (Gram-Schmidt)."""
+    a = v[:3] / np.linalg.norm(v[:3])
+    b = v[3:] - a * (a @ v[3:])
+    b /= np.linalg.norm(b)
+    return np.stack([a, b, np.cross(a, b)], 1)
+
+
+def pose(position, six):
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = rotation_of_six(six), position
+    return m
+
+
+class Roles:
+    """reference_policy.SceneRoles from what perception read: objects in role order (moved, then COLL's container)."""
+
+    def __init__(self, task, y, asset):
+        self.task, self.asset = task, asset
+        self.roles = [0, 1] if task == "COLL" else [0]
+        self.has_goal_pose = task != "COLL"
+        self.goal = (y[19:22], rotation_of_six(y[22:28])) if self.has_goal_pose else (np.zeros(3), np.eye(3))
+        self.obstacle = y[28:31] if task == "OVR" else np.zeros(3)
+
+
+_perception = {}
+_heads = {}
+_episode = {"instruction": None, "task": None}
+
+
+def load(torch):
+    directory = os.environ.get("MANISOFT_PERCEPTION_MODELS")
+    if not directory or not os.environ.get("MANISOFT_REFERENCE_MODELS"):
+        raise RuntimeError("set MANISOFT_PERCEPTION_MODELS (image_policy.py train's directory) and MANISOFT_REFERENCE_MODELS "
+                           "(reference_policy.py train's directory)")
+    paths = sorted(glob.glob(os.path.join(directory, "*.perception.pt")))
+    if not paths:
+        raise RuntimeError(f"MANISOFT_PERCEPTION_MODELS={directory}: no <TASK>.perception.pt")
+    torch.set_num_threads(1)
+    for p in paths:
+        m = Perception(p, torch)
+        _perception[m.task] = m
+
+
+def reset():
+    """Called by evaluate.py at the start of every episode: forgets the episode."""
+    _episode["instruction"] = _episode["task"] = None
+    for m in list(_perception.values()) + list(_heads.values()):
+        m.reset()
+
+
+def act(obs):
+    """The harness's python:manisoft.image_policy:act (--action-mode ee_pose, the default image
+    observation): the next end-effector target from obs["image"] and obs["instruction"]."""
+    import torch
+    if not _perception:
+        load(torch)
+    instruction = str(obs["instruction"])
+    if _episode["instruction"] != instruction:
+        _episode["instruction"] = instruction
+        _episode["task"] = task_of(instruction, _perception)
+    task = _episode["task"]
+    if task not in _heads:
+        _heads[task] = rp.Policy(os.path.join(os.environ["MANISOFT_REFERENCE_MODELS"], f"{task}.pt"), torch)
+    head = _heads[task]
+    y, asset = _perception[task](obs["image"], instruction)
+    objects = [pose(y[10:13], y[13:19])] + ([pose(y[19:22], y[22:28])] if task == "COLL" else [])
+    s = 0.0 if head.previous is None else float(head.previous[6] >= 0.5)
+    seen = {"end_effector": pose(y[0:3], y[3:9]), "gripper_width": max(y[9], 0.0), "gripper_state": s,
+            "object_poses": np.stack(objects)}
+    return head(seen, Roles(task, y, asset))
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description="The image + instruction reference policy on the end-effector track: train its perception")
+    sub = p.add_subparsers(dest="command", required=True)
+    t = sub.add_parser("train", help="train one perception model per task on rendered frames of a generated dataset")
+    t.add_argument("--data", required=True, action="append",
+                   help="DATASET_DIR:IMAGES_DIR (generate_dataset's folder and render_dataset's for it; repeat for more)")
+    t.add_argument("--out", required=True, help="directory for <TASK>.perception.pt")
+    t.add_argument("--tasks", default="ALN,COLL")
+    t.add_argument("--epochs", type=int, default=8)
+    t.add_argument("--batch", type=int, default=64)
+    t.add_argument("--lr", type=float, default=1e-3)
+    t.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
+    t.add_argument("--word-drop", type=float, default=0.15, help="the chance a training instruction's word is replaced by 'unknown'")
+    t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--threads", type=int, default=2)
+    t.add_argument("--resume", action="store_true", help="continue from the checkpoint of a killed run")
+    t.add_argument("--stop-after", type=int, default=None, help="stop after this many epochs of this run, leaving the checkpoint")
+    args = p.parse_args(argv)
+    train(args)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

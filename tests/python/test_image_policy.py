@@ -1,0 +1,107 @@
+"""The image + instruction reference policy (examples/python/image_policy.py) on a tiny dataset
+written by generate_dataset and rendered by render_dataset: the crop is the table region,
+training lowers the loss, the saved model answers as the trained network did, the task is told
+from the instruction, and its act() drives the end-effector track through evaluate.py from the
+image alone."""
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+import torch
+
+import evaluate
+import image_policy as ip
+import reference_policy as rp
+
+
+class ImagePolicyTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp(prefix="manisoft_image_policy_")
+        cls.data, cls.images = os.path.join(cls.dir, "data"), os.path.join(cls.dir, "images")
+        subprocess.run([os.environ["MANISOFT_GENERATE_DATASET"], "--tasks", "ALN", "--clean", "4", "--randomized", "1",
+                        "--seed", "0", "--out", cls.data], check=True, stdout=subprocess.DEVNULL)
+        subprocess.run([os.environ["MANISOFT_RENDER_DATASET"], cls.data, "--out", cls.images, "--every", "36",
+                        "--image-size", "192", "192"], check=True, stdout=subprocess.DEVNULL)
+        cls.models = os.path.join(cls.dir, "models")
+        cls.args = ["train", "--data", f"{cls.data}:{cls.images}", "--out", cls.models, "--tasks", "ALN", "--epochs", "6",
+                    "--batch", "16", "--threads", "1"]
+        ip.main(cls.args)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.dir, ignore_errors=True)
+
+    def test_the_crop_is_the_table_region_at_the_network_size(self):
+        image = np.zeros((192, 192, 3), dtype=np.uint8)
+        image[54, 48] = 200  # the crop's top left pixel: (0.25 * 192, 0.28125 * 192)
+        self.assertEqual(ip.crop(image).shape, (96, 96, 3))
+        self.assertEqual(ip.crop(image)[0, 0, 0], 200)
+        big = np.zeros((384, 384, 3), dtype=np.uint8)
+        big[108:110, 96:98] = 100  # 2 x 2 pixels averaged into the crop's first
+        self.assertEqual(ip.crop(big)[0, 0, 0], 100)
+        with self.assertRaisesRegex(ValueError, "100 x 100 image"):
+            ip.crop(np.zeros((100, 100, 3), dtype=np.uint8))
+
+    def test_training_lowers_the_loss_and_the_saved_model_answers_the_same(self):
+        saved = torch.load(os.path.join(self.models, "ALN.perception.pt"))
+        losses = [train for _, train, _, _ in saved["history"]]
+        self.assertEqual(len(losses), 6)
+        self.assertLess(losses[-1], 0.5 * losses[0], losses)
+        # the labels are the recorded state at the frames' steps: the goal marker's pose of the scene
+        frames = ip.read_frames([f"{self.data}:{self.images}"], "ALN")["train"]
+        self.assertGreater(len(frames["images"]), 20)
+        trained = ip.build_model(torch, len(saved["vocabulary"]), len(saved["assets"]))
+        trained.load_state_dict(torch.load(os.path.join(self.models, "ALN.perception.pt.checkpoint"))["model"])
+        trained.eval()
+        loaded = ip.Perception(os.path.join(self.models, "ALN.perception.pt"), torch)
+        tokens, offsets = ip.encode(torch, [frames["instructions"][0][0]], loaded.vocabulary)
+        image = torch.from_numpy(frames["images"][0][None])
+        with torch.no_grad():
+            self.assertTrue(torch.equal(trained(image, tokens, offsets), loaded.model(image, tokens, offsets)))
+
+    def test_labels_are_the_recorded_state(self):
+        scene = {"task": "ALN", "goal": {"object": 0, "goal_pose": {"position": [0.3, 0.4, 0.75], "rotation": np.eye(3).tolist()}},
+                 "objects": [{"asset_id": "shoe"}], "obstacles": []}
+        eef = np.array([0.1, 0.2, 0.9, 1.0, 0.0, 0.0, 0.0])
+        obj = np.array([[0.5, -0.1, 0.8, 0.0, 0.0, 0.0, 1.0]])  # turned a half turn about z
+        y, asset = ip.labels_of(scene, eef, np.array([0.04, 1.0]), obj)
+        self.assertEqual(asset, "shoe")
+        np.testing.assert_allclose(y[0:3], [0.1, 0.2, 0.9])
+        np.testing.assert_allclose(y[3:9], [1, 0, 0, 0, 1, 0])
+        self.assertAlmostEqual(y[9], 0.04)
+        np.testing.assert_allclose(y[10:19], [0.5, -0.1, 0.8, -1, 0, 0, 0, -1, 0], atol=1e-12)
+        np.testing.assert_allclose(y[19:22], [0.3, 0.4, 0.75])
+        np.testing.assert_allclose(ip.rotation_of_six(y[13:19]), np.diag([-1.0, -1.0, 1.0]), atol=1e-12)
+
+    def test_the_task_is_told_from_the_instruction(self):
+        a = ip.Perception(os.path.join(self.models, "ALN.perception.pt"), torch)
+        b = ip.Perception.__new__(ip.Perception)
+        b.counts = {"put": 5, "into": 5, "the": 10, "basket": 5}
+        models = {"ALN": a, "COLL": b}
+        self.assertEqual(ip.task_of("Place the shoe at the marker.", models), "ALN")
+        self.assertEqual(ip.task_of("Put it into the basket, please.", models), "COLL")
+
+    def test_evaluate_runs_it_from_the_image_on_the_end_effector_track(self):
+        heads = os.path.join(self.dir, "heads")
+        rp.main(["train", "--data", self.data, "--out", heads, "--tasks", "ALN", "--epochs", "3", "--batch", "64", "--width", "64",
+                 "--stride", "8", "--threads", "1"])
+        os.environ["MANISOFT_REFERENCE_MODELS"], os.environ["MANISOFT_PERCEPTION_MODELS"] = heads, self.models
+        out = os.path.join(self.dir, "eval")
+        code = evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", "python:image_policy:act", "--action-mode", "ee_pose",
+                              "--image-size", "192", "192", "--indices", "0", "--out", out])
+        self.assertEqual(code, 0)
+        with open(os.path.join(out, "episodes.jsonl")) as f:
+            episodes = [json.loads(line) for line in f if line.strip()]
+        self.assertEqual(len(episodes), 1)
+        # a model this small fails the episode; it must fail it by the task, never by the policy
+        self.assertNotIn(episodes[0]["failure"], ("policy_error", "bad_action", "policy_timeout"), episodes[0])
+        self.assertGreater(episodes[0]["steps"], 36)
+
+
+if __name__ == "__main__":
+    unittest.main()
