@@ -45,12 +45,15 @@ except ImportError:
 CROP = (0.25, 0.28125, 0.75, 0.78125)  # left, top, right, bottom: the table and the space above it
 SIZE = 96  # the crop's pixels a side
 KEYPOINTS = 64
-# the answer vector: (first column, length, unit of its error in the loss)
+# the answer vector: (first column, length, unit of its error in the loss); a symmetric object's
+# rotation is partly unobservable, hence its larger unit
 FIELDS = {"ee_position": (0, 3, 0.01), "ee_rotation": (3, 6, 0.05), "width": (9, 1, 0.005),
-          "object_position": (10, 3, 0.01), "object_rotation": (13, 6, 0.05),
-          "second_position": (19, 3, 0.01), "second_rotation": (22, 6, 0.05), "obstacle": (28, 3, 0.01)}
+          "object_position": (10, 3, 0.01), "object_rotation": (13, 6, 0.3),
+          "second_position": (19, 3, 0.01), "second_rotation": (22, 6, 0.1), "obstacle": (28, 3, 0.01)}
 ANSWER = 31
 STATIC = ("second_position", "second_rotation", "obstacle")
+POINTS = ("ee_position", "object_position", "second_position", "obstacle")  # located by keypoints
+PIXEL = 2.0 / SIZE  # a crop pixel in the keypoints' coordinates (-1 to 1 across the crop)
 
 
 def words(text):
@@ -91,11 +94,54 @@ def labels_of(scene, eef, grip, objects):
     return y, roles.asset
 
 
+class Camera:
+    """The scene's camera (scene JSON "cameras"[0]): world points to the crop's coordinates (-1 to 1
+    across, x right, y down) and back, onto a given height."""
+
+    def __init__(self, spec):
+        self.position = np.asarray(spec["position"], dtype=np.float64)
+        forward = np.asarray(spec["look_at"], dtype=np.float64) - self.position
+        self.forward = forward / np.linalg.norm(forward)
+        right = np.cross(self.forward, np.asarray(spec["up"], dtype=np.float64))
+        self.right = right / np.linalg.norm(right)
+        self.up = np.cross(self.right, self.forward)
+        self.tan = np.tan(np.radians(spec["fov_y_deg"]) / 2)
+        self.aspect = spec["width"] / spec["height"]
+        self.spec = {k: spec[k] for k in ("position", "look_at", "up", "fov_y_deg", "width", "height")}
+
+    def to_crop(self, p):
+        d = np.asarray(p, dtype=np.float64) - self.position
+        depth = d @ self.forward
+        ndc = np.array([(d @ self.right) / (depth * self.tan * self.aspect), (d @ self.up) / (depth * self.tan)])
+        fraction = np.array([(ndc[0] + 1) / 2, (1 - ndc[1]) / 2])  # of the image's width and height
+        return 2 * (fraction - [CROP[0], CROP[1]]) / [CROP[2] - CROP[0], CROP[3] - CROP[1]] - 1
+
+    def rays(self, torch, uv):
+        """Unit-free ray directions (N x K x 3) through crop coordinates uv (N x K x 2)."""
+        fx = CROP[0] + (CROP[2] - CROP[0]) * (uv[..., 0] + 1) / 2
+        fy = CROP[1] + (CROP[3] - CROP[1]) * (uv[..., 1] + 1) / 2
+        ax, ay = (2 * fx - 1) * self.tan * self.aspect, (1 - 2 * fy) * self.tan
+        basis = torch.tensor(np.stack([self.forward, self.right, self.up]), dtype=uv.dtype)
+        return basis[0] + ax[..., None] * basis[1] + ay[..., None] * basis[2]
+
+    def on_height(self, torch, uv, z):
+        """The points (N x K x 3) on the rays through uv at heights z (N x K)."""
+        d = self.rays(torch, uv)
+        origin = torch.tensor(self.position, dtype=uv.dtype)
+        return origin + ((z - origin[2]) / d[..., 2])[..., None] * d
+
+
+def points_of(camera, y):
+    """The crop coordinates (len(POINTS) x 2) of the answer's points."""
+    return np.stack([camera.to_crop(y[FIELDS[name][0]:FIELDS[name][0] + 3]) for name in POINTS])
+
+
 def read_frames(pairs, task):
     """Every rendered frame of the task's episodes: per mask (train, valid) the crops (N x SIZE x
     SIZE x 3 uint8), the answers (N x ANSWER), the assets and the episode's instructions."""
     import h5py
-    out = {m: {"images": [], "answers": [], "assets": [], "instructions": []} for m in ("train", "valid")}
+    out = {m: {"images": [], "answers": [], "points": [], "assets": [], "instructions": []} for m in ("train", "valid")}
+    out["camera"] = None
     for pair in pairs:
         data, images = pair.split(":", 1)
         with h5py.File(os.path.join(data, "dataset.hdf5"), "r") as index:
@@ -109,6 +155,10 @@ def read_frames(pairs, task):
                     frames = f["data"][demo]["images"]["agentview_image"][()]
                     steps = f["data"][demo]["images"]["agentview_image_steps"][()]
                 scene = json.loads(g.attrs["scene"])
+                if out["camera"] is None:
+                    out["camera"] = Camera(scene["cameras"][0])
+                elif Camera(scene["cameras"][0]).spec != out["camera"].spec:
+                    raise ValueError(f"{data}: {demo}'s camera differs from the other episodes' (the policy reads one view)")
                 eef, grip, obj = (g["obs"][k][()].astype(np.float64) for k in ("eef_pose", "gripper", "object_poses"))
                 obj = obj.reshape(len(obj), -1, 7)
                 said = [str(g.attrs["instruction"])] + json.loads(g.attrs["instructions_seen"])
@@ -117,6 +167,7 @@ def read_frames(pairs, task):
                     y, asset = labels_of(scene, eef[step], grip[step], obj[step])
                     m["images"].append(crop(frame))
                     m["answers"].append(y)
+                    m["points"].append(points_of(out["camera"], y))
                     m["assets"].append(asset)
                     m["instructions"].append(said)
     return out
@@ -124,21 +175,31 @@ def read_frames(pairs, task):
 
 # ---- the network
 
-def build_model(torch, vocabulary, assets):
+REGRESSED = [FIELDS["ee_position"][0] + 2, FIELDS["object_position"][0] + 2, FIELDS["second_position"][0] + 2,
+             FIELDS["obstacle"][0] + 2] + [c + i for name in ("ee_rotation", "width", "object_rotation", "second_rotation")
+                                              for c, n, _ in [FIELDS[name]] for i in range(n)]  # heights, then the rest
+
+
+def build_model(torch, vocabulary, assets, camera):
     nn = torch.nn
 
     class Perception(nn.Module):
         def __init__(self):
             super().__init__()
             self.c1, self.c2 = nn.Conv2d(5, 16, 5, 2, 2), nn.Conv2d(16, 32, 3, 2, 1)
+            self.n1, self.n2 = nn.BatchNorm2d(16), nn.BatchNorm2d(32)
             self.c3, self.c4 = nn.Conv2d(32, KEYPOINTS, 3, 1, 1), nn.Conv2d(KEYPOINTS, 64, 3, 2, 1)
+            self.sharpness = nn.Parameter(torch.full((1, KEYPOINTS, 1), 5.0))  # the spatial softmax's inverse temperature
             self.words = nn.EmbeddingBag(vocabulary + 1, 32, mode="mean")  # index 0: a word training never saw
             self.film = nn.Linear(32, 2 * KEYPOINTS)
-            self.head = nn.Sequential(nn.Linear(2 * KEYPOINTS + 64 + 32, 256), nn.ReLU(), nn.Linear(256, 256), nn.ReLU(),
-                                      nn.Linear(256, ANSWER + assets))
+            self.located = nn.Conv2d(KEYPOINTS, len(POINTS), 1)  # a heat map per located point
+            self.head = nn.Sequential(nn.Linear(2 * KEYPOINTS + 2 * len(POINTS) + 64 + 32, 256), nn.ReLU(), nn.Linear(256, 256),
+                                      nn.ReLU(), nn.Linear(256, len(REGRESSED) + assets))
             grid = torch.linspace(-1.0, 1.0, SIZE)
             self.register_buffer("coords", torch.stack(torch.meshgrid(grid, grid, indexing="ij"))[None])
-            half = torch.linspace(-1.0, 1.0, SIZE // 4)
+            self.register_buffer("mean", torch.zeros(len(REGRESSED)))
+            self.register_buffer("spread", torch.ones(len(REGRESSED)))
+            half = (torch.arange(SIZE // 4, dtype=torch.float32) * 4 + 2) * PIXEL - 1  # the cells' centres
             self.register_buffer("kx", half[None, None, None, :].expand(1, 1, SIZE // 4, SIZE // 4).reshape(1, 1, -1))
             self.register_buffer("ky", half[None, None, :, None].expand(1, 1, SIZE // 4, SIZE // 4).reshape(1, 1, -1))
 
@@ -146,14 +207,24 @@ def build_model(torch, vocabulary, assets):
             """images: N x SIZE x SIZE x 3 uint8; tokens, offsets: the instructions' word indices."""
             x = images.permute(0, 3, 1, 2).float() / 255.0
             x = torch.cat([x, self.coords.expand(len(x), -1, -1, -1)], 1).contiguous(memory_format=torch.channels_last)
-            x = torch.relu(self.c2(torch.relu(self.c1(x))))
+            x = torch.relu(self.n2(self.c2(torch.relu(self.n1(self.c1(x))))))
             e = self.words(tokens, offsets)
             scale, shift = self.film(e).chunk(2, 1)
-            k = torch.relu(self.c3(x) * (1 + scale[:, :, None, None]) + shift[:, :, None, None])
-            soft = torch.softmax(k.flatten(2), 2)
+            k = self.c3(x) * (1 + scale[:, :, None, None]) + shift[:, :, None, None]
+            soft = torch.softmax(k.flatten(2) * self.sharpness, 2)
             points = torch.cat([(soft * self.kx).sum(2), (soft * self.ky).sum(2)], 1)
-            pooled = torch.relu(self.c4(k)).mean((2, 3))
-            return self.head(torch.cat([points, pooled, e], 1))
+            heat = torch.softmax(self.located(k).flatten(2), 2)
+            uv = torch.stack([(heat * self.kx).sum(2), (heat * self.ky).sum(2)], 2)  # N x len(POINTS) x 2
+            pooled = torch.relu(self.c4(torch.relu(k))).mean((2, 3))
+            out = self.head(torch.cat([points, uv.flatten(1), pooled, e], 1))
+            # the regressed values as the training labels' mean plus their spread times the output
+            regressed = self.mean + self.spread * out[:, :len(REGRESSED)]
+            answer = torch.zeros(len(x), ANSWER, dtype=x.dtype)
+            answer[:, REGRESSED] = regressed
+            where = camera.on_height(torch, uv, regressed[:, :len(POINTS)])
+            for i, name in enumerate(POINTS):
+                answer[:, FIELDS[name][0]:FIELDS[name][0] + 3] = where[:, i]
+            return torch.cat([answer, uv.flatten(1), out[:, len(REGRESSED):]], 1)
 
     return Perception()
 
@@ -171,9 +242,15 @@ def encode(torch, texts, vocabulary, drop=0.0, generator=None):
     return torch.tensor(tokens, dtype=torch.long), torch.tensor(offsets, dtype=torch.long)
 
 
-def loss_of(torch, out, answers, asset_ids, scales):
-    squared = ((out[:, :ANSWER] - answers) / scales) ** 2
-    return squared.mean() + torch.nn.functional.cross_entropy(out[:, ANSWER:], asset_ids)
+HEAD = ANSWER + 2 * len(POINTS)  # the answer, the located points' crop coordinates, then the asset logits
+
+
+def loss_of(torch, out, answers, points, asset_ids, scales):
+    """Squared errors of the answer in units of FIELDS', of the located points in crop pixels, and
+    the asset's cross-entropy. scales: 1 / unit per column, 0 where the task has no such thing."""
+    squared = ((out[:, :ANSWER] - answers) * scales[:ANSWER]) ** 2
+    located = ((out[:, ANSWER:HEAD] - points) * scales[ANSWER:]) ** 2
+    return squared.mean() + located.mean() + torch.nn.functional.cross_entropy(out[:, HEAD:], asset_ids)
 
 
 def errors_of(torch, out, answers):
@@ -181,10 +258,13 @@ def errors_of(torch, out, answers):
     return {name: float((out[:, c:c + n] - answers[:, c:c + n]).abs().mean()) for name, (c, n, _) in FIELDS.items()}
 
 
-def scales_of(torch):
-    s = np.zeros(ANSWER, dtype=np.float32)
-    for c, n, unit in FIELDS.values():
-        s[c:c + n] = unit
+def scales_of(torch, task):
+    s = np.zeros(HEAD, dtype=np.float32)
+    for name, (c, n, unit) in FIELDS.items():
+        s[c:c + n] = 0.0 if name == "obstacle" and task != "OVR" else 1.0 / unit
+    s[ANSWER:] = 1.0 / PIXEL
+    if task != "OVR":
+        s[HEAD - 2:HEAD] = 0.0
     return torch.from_numpy(s)
 
 
@@ -204,10 +284,13 @@ def train_task(args, task, torch):
     vocabulary = {w: i + 1 for i, w in enumerate(sorted(counts))}
     images = torch.from_numpy(np.stack(train["images"]))
     answers = torch.from_numpy(np.asarray(train["answers"], dtype=np.float32))
+    points = torch.from_numpy(np.asarray(train["points"], dtype=np.float32).reshape(len(answers), -1))
     asset_ids = torch.tensor([assets.index(a) for a in train["assets"]])
-    scales = scales_of(torch)
+    scales = scales_of(torch, task)
     torch.manual_seed(args.seed)
-    model = build_model(torch, len(vocabulary), len(assets))
+    model = build_model(torch, len(vocabulary), len(assets), data["camera"])
+    model.mean.copy_(answers[:, REGRESSED].mean(0))
+    model.spread.copy_(answers[:, REGRESSED].std(0).clamp(min=1e-3))
     optimiser = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=1e-4)
     generator = torch.Generator().manual_seed(args.seed)
     epoch, history = 0, []
@@ -225,6 +308,7 @@ def train_task(args, task, torch):
         if not valid["images"]:
             return None, {}
         vi, va = np.stack(valid["images"]), torch.from_numpy(np.asarray(valid["answers"], dtype=np.float32))
+        vp = torch.from_numpy(np.asarray(valid["points"], dtype=np.float32).reshape(len(va), -1))
         vid = torch.tensor([assets.index(a) if a in assets else 0 for a in valid["assets"]])
         outs = []
         with torch.no_grad():
@@ -233,8 +317,10 @@ def train_task(args, task, torch):
                 outs.append(model(torch.from_numpy(vi[s:s + 512]), tokens, offsets))
         out = torch.cat(outs)
         errors = errors_of(torch, out, va)
-        errors["asset_accuracy"] = float((out[:, ANSWER:].argmax(1) == vid).float().mean())
-        return loss_of(torch, out, va, vid, scales).item(), errors
+        if task != "OVR":
+            del errors["obstacle"]
+        errors["asset_accuracy"] = float((out[:, HEAD:].argmax(1) == vid).float().mean())
+        return loss_of(torch, out, va, vp, vid, scales).item(), errors
 
     t0 = time.perf_counter()
     gamma = args.lr_decay ** (1.0 / max(args.epochs, 1))
@@ -250,7 +336,7 @@ def train_task(args, task, torch):
             pick = torch.randint(0, 1 << 30, (len(idx),), generator=generator)
             texts = [train["instructions"][i][p % len(train["instructions"][i])] for i, p in zip(idx.tolist(), pick.tolist())]
             tokens, offsets = encode(torch, texts, vocabulary, args.word_drop, generator)
-            loss = loss_of(torch, model(images[idx], tokens, offsets), answers[idx], asset_ids[idx], scales)
+            loss = loss_of(torch, model(images[idx], tokens, offsets), answers[idx], points[idx], asset_ids[idx], scales)
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
@@ -272,7 +358,7 @@ def train_task(args, task, torch):
         return None
     tmp = path + ".tmp"
     torch.save({"model": model.state_dict(), "vocabulary": vocabulary, "assets": assets, "task": task, "history": history,
-                "word_counts": counts}, tmp)
+                "word_counts": counts, "camera": data["camera"].spec}, tmp)
     os.replace(tmp, path)
     print(f"{task}: model -> {path}", flush=True)
     return model
@@ -297,7 +383,7 @@ class Perception:
         saved = torch.load(path)
         self.torch, self.task = torch, saved["task"]
         self.vocabulary, self.assets, self.counts = saved["vocabulary"], saved["assets"], saved["word_counts"]
-        self.model = build_model(torch, len(self.vocabulary), len(self.assets))
+        self.model = build_model(torch, len(self.vocabulary), len(self.assets), Camera(saved["camera"]))
         self.model.load_state_dict(saved["model"])
         self.model.eval()
         self.reset()
@@ -313,7 +399,7 @@ class Perception:
             out = self.model(torch.from_numpy(crop(np.asarray(image))[None]), tokens, offsets)[0].numpy().astype(np.float64)
         self.frames += 1
         self.static += (out[:ANSWER] - self.static) / self.frames
-        self.asset_logits += out[ANSWER:]
+        self.asset_logits += out[HEAD:]
         y = out[:ANSWER].copy()
         for name in STATIC:
             c, n, _ = FIELDS[name]

@@ -47,6 +47,21 @@ class ImagePolicyTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "100 x 100 image"):
             ip.crop(np.zeros((100, 100, 3), dtype=np.uint8))
 
+    def test_the_camera_maps_points_to_the_crop_and_back(self):
+        camera = ip.Camera({"position": [2.0, 0.0, 2.35], "look_at": [0.4, 0.0, 0.95], "up": [0, 0, 1], "fov_y_deg": 60.0,
+                            "width": 514, "height": 514})
+        # the point looked at is the image's centre: across, the crop's middle; down, 0.5 - 0.28125 of
+        # the crop's 0.5 of the image height
+        np.testing.assert_allclose(camera.to_crop([0.4, 0.0, 0.95]), [0.0, 2 * (0.5 - 0.28125) / 0.5 - 1], atol=1e-12)
+        # a point a tan(30 deg) * depth to the camera's right lies on the image's right edge
+        depth = np.linalg.norm(np.array([0.4, 0.0, 0.95]) - [2.0, 0.0, 2.35])
+        right = np.array([0.4, 0.0, 0.95]) + np.tan(np.radians(30)) * depth * np.array([0.0, 1.0, 0.0])
+        self.assertAlmostEqual(camera.to_crop(right)[0], 2 * (1.0 - 0.25) / 0.5 - 1)
+        table = np.array([[0.5, -0.13, 0.75], [0.3, 0.4, 0.9]])
+        uv = torch.tensor(np.stack([camera.to_crop(p) for p in table])[None])
+        back = camera.on_height(torch, uv, torch.tensor(table[None, :, 2]))
+        np.testing.assert_allclose(back[0].numpy(), table, atol=1e-12)
+
     def test_training_lowers_the_loss_and_the_saved_model_answers_the_same(self):
         saved = torch.load(os.path.join(self.models, "ALN.perception.pt"))
         losses = [train for _, train, _, _ in saved["history"]]
@@ -55,7 +70,7 @@ class ImagePolicyTest(unittest.TestCase):
         # the labels are the recorded state at the frames' steps: the goal marker's pose of the scene
         frames = ip.read_frames([f"{self.data}:{self.images}"], "ALN")["train"]
         self.assertGreater(len(frames["images"]), 20)
-        trained = ip.build_model(torch, len(saved["vocabulary"]), len(saved["assets"]))
+        trained = ip.build_model(torch, len(saved["vocabulary"]), len(saved["assets"]), ip.Camera(saved["camera"]))
         trained.load_state_dict(torch.load(os.path.join(self.models, "ALN.perception.pt.checkpoint"))["model"])
         trained.eval()
         loaded = ip.Perception(os.path.join(self.models, "ALN.perception.pt"), torch)
