@@ -13,15 +13,20 @@ plus its own previous commands.
 
 Perception: the image's table region (CROP, fractions of the image) at 96 x 96 pixels with two
 coordinate channels; four convolutions, the instruction's words (a bag of embeddings) scaling and
-shifting the third one's channels (FiLM); 64 keypoints (the spatial softmax's expected image
-coordinates of the third one's channels), the fourth one's mean and the instruction embedding into
-an MLP. It answers, in the world frame: the end effector's position and rotation and the finger
-width; the moved object's position and rotation; the second pose of the goal (COLL: the
-container; ALN, OVR: the goal marker); OVR's obstacle's position; and the moved object's asset (a
-class). Trained on frames rendered from the dataset's episodes (render_dataset --every K) with the
-episode's recorded state as labels: squared errors in units of PERCEPTION_SCALES, cross-entropy of
-the asset; each frame's instruction is drawn from the episode's canonical and seen ones, a word
-dropped at random (unseen paraphrases use words training never saw).
+shifting the third one's channels (FiLM). The scene's points (the end effector, the moved object,
+the goal's second pose: COLL's container, ALN's and OVR's marker; OVR's obstacle) are located by a
+heat map each on the third one's 24 x 24 grid (the expected image coordinates under its softmax)
+and placed where the camera ray through them meets a regressed height. An MLP over 64 free
+keypoints of the same kind, the located points, the fourth convolution's mean and the instruction
+embedding regresses the heights, the end effector's, the object's and the second pose's rotations
+(first two columns), the finger width and the moved object's asset (a class). Trained on frames
+rendered from the dataset's episodes (render_dataset --every K), the episode's recorded state the
+labels: squared errors in units of FIELDS' (world) and of a crop pixel (the located points' image
+coordinates), the cross-entropy of each point's heat map cell (the expected position alone leaves
+a spread-out map stuck between candidates) and of the asset. Frames before the grasp, where the
+moved object rests on the table, are drawn --rest-weight times as often. Each frame's instruction
+is drawn from the episode's canonical and seen ones, a word dropped at random (unseen paraphrases
+use words training never saw).
 Acting: the static parts of the scene (the container or goal, the obstacle, the asset) are averaged
 over the episode's frames so far; the end effector, the fingers and the moved object are read from
 the current frame; S is the policy's own last command. The task is the one whose training
@@ -140,7 +145,7 @@ def read_frames(pairs, task):
     """Every rendered frame of the task's episodes: per mask (train, valid) the crops (N x SIZE x
     SIZE x 3 uint8), the answers (N x ANSWER), the assets and the episode's instructions."""
     import h5py
-    out = {m: {"images": [], "answers": [], "points": [], "assets": [], "instructions": []} for m in ("train", "valid")}
+    out = {m: {"images": [], "answers": [], "points": [], "assets": [], "instructions": [], "resting": []} for m in ("train", "valid")}
     out["camera"] = None
     for pair in pairs:
         data, images = pair.split(":", 1)
@@ -162,6 +167,8 @@ def read_frames(pairs, task):
                 eef, grip, obj = (g["obs"][k][()].astype(np.float64) for k in ("eef_pose", "gripper", "object_poses"))
                 obj = obj.reshape(len(obj), -1, 7)
                 said = [str(g.attrs["instruction"])] + json.loads(g.attrs["instructions_seen"])
+                closed = np.flatnonzero(grip[:, 1] >= 0.5)
+                grasp = closed[0] if len(closed) else len(grip)  # the moved object rests on the table before
                 m = out["train" if demo in masks["train"] else "valid"]
                 for frame, step in zip(frames, steps):
                     y, asset = labels_of(scene, eef[step], grip[step], obj[step])
@@ -170,6 +177,7 @@ def read_frames(pairs, task):
                     m["points"].append(points_of(out["camera"], y))
                     m["assets"].append(asset)
                     m["instructions"].append(said)
+                    m["resting"].append(step < grasp)
     return out
 
 
@@ -203,8 +211,9 @@ def build_model(torch, vocabulary, assets, camera):
             self.register_buffer("kx", half[None, None, None, :].expand(1, 1, SIZE // 4, SIZE // 4).reshape(1, 1, -1))
             self.register_buffer("ky", half[None, None, :, None].expand(1, 1, SIZE // 4, SIZE // 4).reshape(1, 1, -1))
 
-        def forward(self, images, tokens, offsets):
-            """images: N x SIZE x SIZE x 3 uint8; tokens, offsets: the instructions' word indices."""
+        def forward(self, images, tokens, offsets, heat_maps=False):
+            """images: N x SIZE x SIZE x 3 uint8; tokens, offsets: the instructions' word indices.
+            heat_maps: also return the located points' heat map logits (N x len(POINTS) x cells)."""
             x = images.permute(0, 3, 1, 2).float() / 255.0
             x = torch.cat([x, self.coords.expand(len(x), -1, -1, -1)], 1).contiguous(memory_format=torch.channels_last)
             x = torch.relu(self.n2(self.c2(torch.relu(self.n1(self.c1(x))))))
@@ -213,7 +222,8 @@ def build_model(torch, vocabulary, assets, camera):
             k = self.c3(x) * (1 + scale[:, :, None, None]) + shift[:, :, None, None]
             soft = torch.softmax(k.flatten(2) * self.sharpness, 2)
             points = torch.cat([(soft * self.kx).sum(2), (soft * self.ky).sum(2)], 1)
-            heat = torch.softmax(self.located(k).flatten(2), 2)
+            logits = self.located(k).flatten(2)
+            heat = torch.softmax(logits, 2)
             uv = torch.stack([(heat * self.kx).sum(2), (heat * self.ky).sum(2)], 2)  # N x len(POINTS) x 2
             pooled = torch.relu(self.c4(torch.relu(k))).mean((2, 3))
             out = self.head(torch.cat([points, uv.flatten(1), pooled, e], 1))
@@ -224,7 +234,8 @@ def build_model(torch, vocabulary, assets, camera):
             where = camera.on_height(torch, uv, regressed[:, :len(POINTS)])
             for i, name in enumerate(POINTS):
                 answer[:, FIELDS[name][0]:FIELDS[name][0] + 3] = where[:, i]
-            return torch.cat([answer, uv.flatten(1), out[:, len(REGRESSED):]], 1)
+            out = torch.cat([answer, uv.flatten(1), out[:, len(REGRESSED):]], 1)
+            return (out, logits) if heat_maps else out
 
     return Perception()
 
@@ -245,17 +256,36 @@ def encode(torch, texts, vocabulary, drop=0.0, generator=None):
 HEAD = ANSWER + 2 * len(POINTS)  # the answer, the located points' crop coordinates, then the asset logits
 
 
-def loss_of(torch, out, answers, points, asset_ids, scales):
-    """Squared errors of the answer in units of FIELDS', of the located points in crop pixels, and
-    the asset's cross-entropy. scales: 1 / unit per column, 0 where the task has no such thing."""
+def cells_of(torch, points):
+    """The heat map cell (row-major on the SIZE / 4 grid) holding each point (N x 2 len(POINTS)), -100
+    (ignored) for a point outside the crop."""
+    uv = points.reshape(len(points), -1, 2)
+    cell = torch.floor((uv + 1) / PIXEL / 4).long()
+    inside = ((cell >= 0) & (cell < SIZE // 4)).all(2)
+    return torch.where(inside, cell[..., 1] * (SIZE // 4) + cell[..., 0], torch.full_like(cell[..., 0], -100))
+
+
+def loss_of(torch, out, answers, points, asset_ids, scales, heat=None):
+    """Squared errors of the answer in units of FIELDS', of the located points in crop pixels, the
+    asset's cross-entropy and, given the heat map logits, each point's cell's cross-entropy (the
+    expected position alone leaves a spread-out heat map stuck between candidates). scales: 1 / unit
+    per column, 0 where the task has no such thing."""
     squared = ((out[:, :ANSWER] - answers) * scales[:ANSWER]) ** 2
     located = ((out[:, ANSWER:HEAD] - points) * scales[ANSWER:]) ** 2
-    return squared.mean() + located.mean() + torch.nn.functional.cross_entropy(out[:, HEAD:], asset_ids)
+    loss = squared.mean() + located.mean() + torch.nn.functional.cross_entropy(out[:, HEAD:], asset_ids)
+    if heat is not None:
+        cells = cells_of(torch, points)
+        active = scales[ANSWER::2] > 0
+        loss = loss + torch.nn.functional.cross_entropy(heat[:, active].flatten(0, 1), cells[:, active].flatten(), ignore_index=-100)
+    return loss
 
 
 def errors_of(torch, out, answers):
-    """Mean absolute error per field (m for positions, width; 6D units for rotations)."""
-    return {name: float((out[:, c:c + n] - answers[:, c:c + n]).abs().mean()) for name, (c, n, _) in FIELDS.items()}
+    """Mean error per field: the distance for positions (m), the mean absolute error otherwise."""
+    def error(c, n):
+        d = out[:, c:c + n] - answers[:, c:c + n]
+        return float(d.norm(dim=1).mean() if n == 3 else d.abs().mean())
+    return {name: error(c, n) for name, (c, n, _) in FIELDS.items()}
 
 
 def scales_of(torch, task):
@@ -286,6 +316,7 @@ def train_task(args, task, torch):
     answers = torch.from_numpy(np.asarray(train["answers"], dtype=np.float32))
     points = torch.from_numpy(np.asarray(train["points"], dtype=np.float32).reshape(len(answers), -1))
     asset_ids = torch.tensor([assets.index(a) for a in train["assets"]])
+    weights = torch.tensor([args.rest_weight if r else 1.0 for r in train["resting"]], dtype=torch.float64)
     scales = scales_of(torch, task)
     torch.manual_seed(args.seed)
     model = build_model(torch, len(vocabulary), len(assets), data["camera"])
@@ -329,14 +360,17 @@ def train_task(args, task, torch):
         for group in optimiser.param_groups:
             group["lr"] = args.lr * gamma ** epoch
         model.train()
-        order = torch.randperm(len(images), generator=generator)
+        # frames of the object at rest drawn --rest-weight times as often: the moved object is held
+        # for most of an episode, and a network that follows the hand is wrong only before the grasp
+        order = torch.multinomial(weights, len(images), replacement=True, generator=generator)
         total = 0.0
         for start in range(0, len(order), args.batch):
             idx = order[start:start + args.batch]
             pick = torch.randint(0, 1 << 30, (len(idx),), generator=generator)
             texts = [train["instructions"][i][p % len(train["instructions"][i])] for i, p in zip(idx.tolist(), pick.tolist())]
             tokens, offsets = encode(torch, texts, vocabulary, args.word_drop, generator)
-            loss = loss_of(torch, model(images[idx], tokens, offsets), answers[idx], points[idx], asset_ids[idx], scales)
+            out, heat = model(images[idx], tokens, offsets, heat_maps=True)
+            loss = loss_of(torch, out, answers[idx], points[idx], asset_ids[idx], scales, heat)
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
@@ -491,8 +525,37 @@ def act(obs):
     return head(seen, Roles(task, y, asset))
 
 
+def curves(args):
+    """The held-out errors of the located points per epoch (from model or checkpoint files' history)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import torch
+    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=120)
+    for path, style in zip(args.models, ("-", "--", ":", "-.")):
+        saved = torch.load(path)
+        task = saved.get("task", os.path.basename(path).split(".")[0])
+        epochs = [h[0] for h in saved["history"]]
+        for name, colour in zip(POINTS, ("C0", "C1", "C2", "C3")):
+            values = [h[3].get(name) for h in saved["history"]]
+            if all(v is not None for v in values):
+                ax.plot(epochs, [100 * v for v in values], style, color=colour, marker="o", ms=3,
+                        label=f"{task}: {name.replace('_position', '').replace('second', 'container / marker')}")
+    ax.set_xlabel("epoch")
+    ax.set_ylabel("held-out error, cm (mean distance)")
+    ax.set_ylim(bottom=0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    ax.set_title("Image policy's perception: held-out position errors (valid mask)", fontsize=9)
+    fig.tight_layout()
+    tmp = args.out + ".tmp.png"
+    fig.savefig(tmp)
+    os.replace(tmp, args.out)
+    print(f"curves -> {args.out}")
+
+
 def main(argv=None):
-    p = argparse.ArgumentParser(description="The image + instruction reference policy on the end-effector track: train its perception")
+    p = argparse.ArgumentParser(description="The image + instruction reference policy on the end-effector track: train its perception, plot")
     sub = p.add_subparsers(dest="command", required=True)
     t = sub.add_parser("train", help="train one perception model per task on rendered frames of a generated dataset")
     t.add_argument("--data", required=True, action="append",
@@ -503,13 +566,17 @@ def main(argv=None):
     t.add_argument("--batch", type=int, default=64)
     t.add_argument("--lr", type=float, default=1e-3)
     t.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
+    t.add_argument("--rest-weight", type=float, default=4.0, help="how much more often frames of the moved object at rest are drawn")
     t.add_argument("--word-drop", type=float, default=0.15, help="the chance a training instruction's word is replaced by 'unknown'")
     t.add_argument("--seed", type=int, default=0)
     t.add_argument("--threads", type=int, default=2)
     t.add_argument("--resume", action="store_true", help="continue from the checkpoint of a killed run")
     t.add_argument("--stop-after", type=int, default=None, help="stop after this many epochs of this run, leaving the checkpoint")
+    c = sub.add_parser("curves", help="plot the held-out position errors per epoch of trained models")
+    c.add_argument("models", nargs="+", help="<TASK>.perception.pt files (or their .checkpoint)")
+    c.add_argument("--out", required=True, help="PNG file")
     args = p.parse_args(argv)
-    train(args)
+    (train if args.command == "train" else curves)(args)
     return 0
 
 

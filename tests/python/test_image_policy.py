@@ -62,6 +62,12 @@ class ImagePolicyTest(unittest.TestCase):
         back = camera.on_height(torch, uv, torch.tensor(table[None, :, 2]))
         np.testing.assert_allclose(back[0].numpy(), table, atol=1e-12)
 
+    def test_heat_map_cells_of_points(self):
+        # the crop's 96 pixels in 24 cells of 4: (0, 0) is pixel 48 across and down, cell 12 of each;
+        # the top left corner is cell 0; a point off the crop is ignored (-100)
+        points = torch.tensor([[0.0, 0.0, -1.0, -1.0, 1.5, 0.0, 0.0, 0.99]])
+        self.assertEqual(ip.cells_of(torch, points).tolist(), [[12 * 24 + 12, 0, -100, 23 * 24 + 12]])
+
     def test_training_lowers_the_loss_and_the_saved_model_answers_the_same(self):
         saved = torch.load(os.path.join(self.models, "ALN.perception.pt"))
         losses = [train for _, train, _, _ in saved["history"]]
