@@ -326,12 +326,7 @@ def train_task(args, task, torch):
     generator = torch.Generator().manual_seed(args.seed)
     epoch, history = 0, []
     if args.resume and os.path.exists(checkpoint):
-        saved = torch.load(checkpoint)
-        model.load_state_dict(saved["model"])
-        optimiser.load_state_dict(saved["optimiser"])
-        generator.set_state(saved["generator"])
-        epoch, history = saved["epoch"], saved["history"]
-        print(f"{task}: resumed after epoch {epoch}", flush=True)
+        epoch, history = rp.resume(torch, checkpoint, model, optimiser, generator, task)
     print(f"{task}: {len(images)} train / {len(valid['images'])} valid frames, {len(assets)} assets, "
           f"{len(vocabulary)} words", flush=True)
 
@@ -383,17 +378,12 @@ def train_task(args, task, torch):
             f"{k} {v * (100 if k.endswith(('position', 'width', 'obstacle')) else 1):.2f}" for k, v in errors.items()) + ")"
         print(f"{task} epoch {epoch}/{args.epochs}: train loss {total / len(images):.3f}{shown}, "
               f"{time.perf_counter() - t0:.0f} s", flush=True)
-        tmp = checkpoint + ".tmp"
-        torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(), "generator": generator.get_state(),
-                    "epoch": epoch, "history": history}, tmp)
-        os.replace(tmp, checkpoint)
+        rp.write_checkpoint(torch, checkpoint, model, optimiser, generator, epoch, history)
     if epoch < args.epochs:
         print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
         return None
-    tmp = path + ".tmp"
-    torch.save({"model": model.state_dict(), "vocabulary": vocabulary, "assets": assets, "task": task, "history": history,
-                "word_counts": counts, "camera": data["camera"].spec}, tmp)
-    os.replace(tmp, path)
+    rp.save(torch, {"model": model.state_dict(), "vocabulary": vocabulary, "assets": assets, "task": task, "history": history,
+                    "word_counts": counts, "camera": data["camera"].spec}, path)
     print(f"{task}: model -> {path}", flush=True)
     return model
 
@@ -548,10 +538,7 @@ def curves(args):
     ax.legend(fontsize=7, ncol=2)
     ax.set_title("Image policy's perception: held-out position errors (valid mask)", fontsize=9)
     fig.tight_layout()
-    tmp = args.out + ".tmp.png"
-    fig.savefig(tmp)
-    os.replace(tmp, args.out)
-    print(f"curves -> {args.out}")
+    rp.save_figure(fig, args.out)
 
 
 def main(argv=None):
@@ -562,16 +549,13 @@ def main(argv=None):
                    help="DATASET_DIR:IMAGES_DIR (generate_dataset's folder and render_dataset's for it; repeat for more)")
     t.add_argument("--out", required=True, help="directory for <TASK>.perception.pt")
     t.add_argument("--tasks", default="ALN,COLL")
-    t.add_argument("--epochs", type=int, default=8)
+    t.add_argument("--epochs", type=int, default=6)
     t.add_argument("--batch", type=int, default=64)
     t.add_argument("--lr", type=float, default=1e-3)
     t.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
     t.add_argument("--rest-weight", type=float, default=4.0, help="how much more often frames of the moved object at rest are drawn")
     t.add_argument("--word-drop", type=float, default=0.15, help="the chance a training instruction's word is replaced by 'unknown'")
-    t.add_argument("--seed", type=int, default=0)
-    t.add_argument("--threads", type=int, default=2)
-    t.add_argument("--resume", action="store_true", help="continue from the checkpoint of a killed run")
-    t.add_argument("--stop-after", type=int, default=None, help="stop after this many epochs of this run, leaving the checkpoint")
+    rp.add_run_flags(t)
     c = sub.add_parser("curves", help="plot the held-out position errors per epoch of trained models")
     c.add_argument("models", nargs="+", help="<TASK>.perception.pt files (or their .checkpoint)")
     c.add_argument("--out", required=True, help="PNG file")

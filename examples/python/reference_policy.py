@@ -263,6 +263,45 @@ def loss_of(torch, out, x, y):
     return pose + bce(s, (y[:, 6] >= 0.5).float()) + bce(switch, y[:, 7])
 
 
+# ---- training runs (image_policy.py's too)
+
+def save(torch, state, path):
+    """torch.save under a temporary name, then renamed: a file under its final name is complete."""
+    tmp = path + ".tmp"
+    torch.save(state, tmp)
+    os.replace(tmp, path)
+
+
+def resume(torch, checkpoint, model, optimiser, generator, task):
+    """A killed run's checkpoint restored into the model, optimiser and generator: its epoch and history."""
+    saved = torch.load(checkpoint)
+    model.load_state_dict(saved["model"])
+    optimiser.load_state_dict(saved["optimiser"])
+    generator.set_state(saved["generator"])
+    print(f"{task}: resumed after epoch {saved['epoch']}", flush=True)
+    return saved["epoch"], saved["history"]
+
+
+def write_checkpoint(torch, checkpoint, model, optimiser, generator, epoch, history):
+    save(torch, {"model": model.state_dict(), "optimiser": optimiser.state_dict(), "generator": generator.get_state(),
+                 "epoch": epoch, "history": history}, checkpoint)
+
+
+def save_figure(fig, path):
+    tmp = path + ".tmp.png"
+    fig.savefig(tmp)
+    os.replace(tmp, path)
+    print(f"curves -> {path}")
+
+
+def add_run_flags(parser):
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--resume", action="store_true", help="continue from the checkpoint of a killed run")
+    parser.add_argument("--stop-after", type=int, default=None, help="stop after this many epochs of this run (a time-limited "
+                        "job), leaving the checkpoint for --resume")
+
+
 def train_task(args, task, torch):
     path = os.path.join(args.out, f"{task}.pt")
     checkpoint = path + ".checkpoint"
@@ -280,12 +319,7 @@ def train_task(args, task, torch):
     epoch, history = 0, []
     generator = torch.Generator().manual_seed(args.seed)
     if args.resume and os.path.exists(checkpoint):
-        saved = torch.load(checkpoint)
-        model.load_state_dict(saved["model"])
-        optimiser.load_state_dict(saved["optimiser"])
-        generator.set_state(saved["generator"])
-        epoch, history = saved["epoch"], saved["history"]
-        print(f"{task}: resumed after epoch {epoch}", flush=True)
+        epoch, history = resume(torch, checkpoint, model, optimiser, generator, task)
     print(f"{task}: {counts['train']} train / {counts['valid']} valid episodes, {len(x)} samples of {x.shape[1]} inputs", flush=True)
     t0 = time.perf_counter()
     scheduler_gamma = args.lr_decay ** (1.0 / max(args.epochs, 1))
@@ -311,17 +345,12 @@ def train_task(args, task, torch):
         shown = "none (no valid episodes)" if held_out is None else f"{held_out:.4f}"
         print(f"{task} epoch {epoch}/{args.epochs}: train loss {total / len(xn):.4f}, held-out loss {shown}, "
               f"{time.perf_counter() - t0:.0f} s", flush=True)
-        tmp = checkpoint + ".tmp"
-        torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(), "generator": generator.get_state(),
-                    "epoch": epoch, "history": history}, tmp)
-        os.replace(tmp, checkpoint)
+        write_checkpoint(torch, checkpoint, model, optimiser, generator, epoch, history)
     if epoch < args.epochs:
         print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
         return None
-    tmp = path + ".tmp"
-    torch.save({"model": model.state_dict(), "inputs": x.shape[1], "width": args.width, "depth": args.depth,
-                "norm": norm.state(), "assets": assets, "task": task, "history": history, "repeat": args.repeat}, tmp)
-    os.replace(tmp, path)
+    save(torch, {"model": model.state_dict(), "inputs": x.shape[1], "width": args.width, "depth": args.depth,
+                 "norm": norm.state(), "assets": assets, "task": task, "history": history, "repeat": args.repeat}, path)
     print(f"{task}: model -> {path}", flush=True)
     return model
 
@@ -427,10 +456,7 @@ def curves(args):
     ax.legend(fontsize=8)
     ax.set_title("Reference policy (privileged state, end-effector track): learning curves", fontsize=9)
     fig.tight_layout()
-    tmp = args.out + ".tmp.png"
-    fig.savefig(tmp)
-    os.replace(tmp, args.out)
-    print(f"curves -> {args.out}")
+    save_figure(fig, args.out)
 
 
 def main(argv=None):
@@ -449,11 +475,7 @@ def main(argv=None):
     t.add_argument("--depth", type=int, default=3)
     t.add_argument("--stride", type=int, default=2, help="a sample every this many control steps")
     t.add_argument("--repeat", type=int, default=36, help="control steps between the policy's commands")
-    t.add_argument("--seed", type=int, default=0)
-    t.add_argument("--threads", type=int, default=2)
-    t.add_argument("--resume", action="store_true", help="continue from the checkpoint of a killed run")
-    t.add_argument("--stop-after", type=int, default=None, help="stop after this many epochs of this run (a time-limited job), "
-                   "leaving the checkpoint for --resume")
+    add_run_flags(t)
     c = sub.add_parser("curves", help="plot the learning curves of trained models")
     c.add_argument("models", nargs="+", help="<TASK>.pt files")
     c.add_argument("--out", required=True, help="PNG file")

@@ -85,6 +85,17 @@ class ImagePolicyTest(unittest.TestCase):
         with torch.no_grad():
             self.assertTrue(torch.equal(trained(image, tokens, offsets), loaded.model(image, tokens, offsets)))
 
+    def test_a_stopped_run_resumes_to_the_uninterrupted_weights(self):
+        parts = os.path.join(self.dir, "parts")
+        args = [a if a != self.models else parts for a in self.args]
+        ip.main(args + ["--stop-after", "2"])
+        self.assertFalse(os.path.exists(os.path.join(parts, "ALN.perception.pt")))
+        ip.main(args + ["--resume"])
+        a, b = torch.load(os.path.join(self.models, "ALN.perception.pt")), torch.load(os.path.join(parts, "ALN.perception.pt"))
+        self.assertEqual(a["history"], b["history"])
+        for k in a["model"]:
+            self.assertTrue(torch.equal(a["model"][k], b["model"][k]), k)
+
     def test_labels_are_the_recorded_state(self):
         scene = {"task": "ALN", "goal": {"object": 0, "goal_pose": {"position": [0.3, 0.4, 0.75], "rotation": np.eye(3).tolist()}},
                  "objects": [{"asset_id": "shoe"}], "obstacles": []}
