@@ -143,7 +143,8 @@ def points_of(camera, y):
 
 def read_frames(pairs, task):
     """Every rendered frame of the task's episodes: per mask (train, valid) the crops (N x SIZE x
-    SIZE x 3 uint8), the answers (N x ANSWER), the assets and the episode's instructions."""
+    SIZE x 3 uint8), the answers (N x ANSWER), the located points' crop coordinates, the assets,
+    the episode's instructions and whether the moved object still rests (before the grasp)."""
     import h5py
     out = {m: {"images": [], "answers": [], "points": [], "assets": [], "instructions": [], "resting": []} for m in ("train", "valid")}
     out["camera"] = None
@@ -153,6 +154,8 @@ def read_frames(pairs, task):
             masks = {name: {m.decode() for m in index["mask"][name][()]} for name in ("train", "valid")}
             for path in sorted(glob.glob(os.path.join(images, "demo_*.hdf5"))):
                 demo = os.path.basename(path)[:-len(".hdf5")]
+                if demo not in index["data"]:
+                    raise ValueError(f"{path}: {demo} is not in {data}/dataset.hdf5 (images of another dataset?)")
                 g = index["data"][demo]
                 if g.attrs["task"] != task:
                     continue
@@ -165,6 +168,9 @@ def read_frames(pairs, task):
                 elif Camera(scene["cameras"][0]).spec != out["camera"].spec:
                     raise ValueError(f"{data}: {demo}'s camera differs from the other episodes' (the policy reads one view)")
                 eef, grip, obj = (g["obs"][k][()].astype(np.float64) for k in ("eef_pose", "gripper", "object_poses"))
+                if len(steps) and steps.max() >= len(eef):
+                    raise ValueError(f"{path}: a frame at step {steps.max()}, but {data}'s {demo} has {len(eef)} steps "
+                                     "(images of another dataset?)")
                 obj = obj.reshape(len(obj), -1, 7)
                 said = [str(g.attrs["instruction"])] + json.loads(g.attrs["instructions_seen"])
                 closed = np.flatnonzero(grip[:, 1] >= 0.5)
@@ -307,7 +313,7 @@ def train_task(args, task, torch):
         raise ValueError(f"{', '.join(args.data)}: no rendered {task} frames of train-mask episodes")
     assets = sorted(set(train["assets"]))
     counts = {}
-    for said in train["instructions"][::1]:
+    for said in train["instructions"]:
         for text in said:
             for w in words(text):
                 counts[w] = counts.get(w, 0) + 1

@@ -96,6 +96,13 @@ class ImagePolicyTest(unittest.TestCase):
         for k in a["model"]:
             self.assertTrue(torch.equal(a["model"][k], b["model"][k]), k)
 
+    def test_images_of_another_dataset_are_refused_by_name(self):
+        other = os.path.join(self.dir, "other_images")
+        os.makedirs(other, exist_ok=True)
+        shutil.copy(os.path.join(self.images, "demo_0.hdf5"), os.path.join(other, "demo_99.hdf5"))
+        with self.assertRaisesRegex(ValueError, "demo_99.hdf5: demo_99 is not in .*dataset.hdf5"):
+            ip.read_frames([f"{self.data}:{other}"], "ALN")
+
     def test_labels_are_the_recorded_state(self):
         scene = {"task": "ALN", "goal": {"object": 0, "goal_pose": {"position": [0.3, 0.4, 0.75], "rotation": np.eye(3).tolist()}},
                  "objects": [{"asset_id": "shoe"}], "obstacles": []}
