@@ -141,13 +141,11 @@ def points_of(camera, y):
     return np.stack([camera.to_crop(y[FIELDS[name][0]:FIELDS[name][0] + 3]) for name in POINTS])
 
 
-def read_frames(pairs, task):
-    """Every rendered frame of the task's episodes: per mask (train, valid) the crops (N x SIZE x
-    SIZE x 3 uint8), the answers (N x ANSWER), the located points' crop coordinates, the assets,
-    the episode's instructions and whether the moved object still rests (before the grasp)."""
+def episode_frames(pairs, task):
+    """Every rendered frame of the task's episodes, as (mask, image, answer, asset, the episode's
+    instructions, whether the moved object still rests (before the grasp), camera)."""
     import h5py
-    out = {m: {"images": [], "answers": [], "points": [], "assets": [], "instructions": [], "resting": []} for m in ("train", "valid")}
-    out["camera"] = None
+    camera = None
     for pair in pairs:
         data, images = pair.split(":", 1)
         with h5py.File(os.path.join(data, "dataset.hdf5"), "r") as index:
@@ -163,9 +161,9 @@ def read_frames(pairs, task):
                     frames = f["data"][demo]["images"]["agentview_image"][()]
                     steps = f["data"][demo]["images"]["agentview_image_steps"][()]
                 scene = json.loads(g.attrs["scene"])
-                if out["camera"] is None:
-                    out["camera"] = Camera(scene["cameras"][0])
-                elif Camera(scene["cameras"][0]).spec != out["camera"].spec:
+                if camera is None:
+                    camera = Camera(scene["cameras"][0])
+                elif Camera(scene["cameras"][0]).spec != camera.spec:
                     raise ValueError(f"{data}: {demo}'s camera differs from the other episodes' (the policy reads one view)")
                 eef, grip, obj = (g["obs"][k][()].astype(np.float64) for k in ("eef_pose", "gripper", "object_poses"))
                 if len(steps) and steps.max() >= len(eef):
@@ -175,15 +173,27 @@ def read_frames(pairs, task):
                 said = [str(g.attrs["instruction"])] + json.loads(g.attrs["instructions_seen"])
                 closed = np.flatnonzero(grip[:, 1] >= 0.5)
                 grasp = closed[0] if len(closed) else len(grip)  # the moved object rests on the table before
-                m = out["train" if demo in masks["train"] else "valid"]
+                mask = "train" if demo in masks["train"] else "valid"
                 for frame, step in zip(frames, steps):
                     y, asset = labels_of(scene, eef[step], grip[step], obj[step])
-                    m["images"].append(crop(frame))
-                    m["answers"].append(y)
-                    m["points"].append(points_of(out["camera"], y))
-                    m["assets"].append(asset)
-                    m["instructions"].append(said)
-                    m["resting"].append(step < grasp)
+                    yield mask, frame, y, asset, said, step < grasp, camera
+
+
+def read_frames(pairs, task):
+    """Every rendered frame of the task's episodes: per mask (train, valid) the crops (N x SIZE x
+    SIZE x 3 uint8), the answers (N x ANSWER), the located points' crop coordinates, the assets,
+    the episode's instructions and whether the moved object still rests (before the grasp)."""
+    out = {m: {"images": [], "answers": [], "points": [], "assets": [], "instructions": [], "resting": []} for m in ("train", "valid")}
+    out["camera"] = None
+    for mask, frame, y, asset, said, resting, camera in episode_frames(pairs, task):
+        out["camera"] = camera
+        m = out[mask]
+        m["images"].append(crop(frame))
+        m["answers"].append(y)
+        m["points"].append(points_of(camera, y))
+        m["assets"].append(asset)
+        m["instructions"].append(said)
+        m["resting"].append(resting)
     return out
 
 
@@ -404,6 +414,246 @@ def train(args):
     return {task: train_task(args, task, torch) for task in args.tasks.split(",")}
 
 
+# ---- refinement: the end effector and the moved object located again at full resolution
+
+FINE = 2 * SIZE  # the crop's pixels a side at the resolution refinement reads (a 384 x 384 image)
+PATCH, WINDOW = 48, 88  # a refinement patch; the window kept around a training point (the patch shifts up to 20 pixels)
+CELL = 2  # the refinement heat map's cell, fine pixels
+REFINED = ("ee_position", "object_position")
+PASSES = 2  # patches centred first on the first stage's estimate, then on the previous pass's
+
+
+def fine_of(uv):
+    """Crop coordinates (-1 to 1 across) to fine crop pixels (pixel i spans [i, i + 1))."""
+    return (np.asarray(uv, dtype=np.float64) + 1) / 2 * FINE
+
+
+def window(image, centre, size):
+    """The size x size pixels of the image around centre (fine crop pixels), zeros off the image, and
+    their corner (integer fine crop pixels). The image's crop must be FINE pixels a side."""
+    h, w = image.shape[:2]
+    x0, y0, x1, y1 = (int(round(f * s)) for f, s in zip(CROP, (w, h, w, h)))
+    if (x1 - x0, y1 - y0) != (FINE, FINE):
+        raise ValueError(f"image_policy: refinement reads the crop at {FINE} x {FINE} pixels; a {w} x {h} image's is "
+                         f"{x1 - x0} x {y1 - y0} (use --image-size {2 * FINE} {2 * FINE})")
+    corner = np.floor(np.clip(centre, -FINE, 2 * FINE) - size / 2).astype(int)  # the image and around it
+    out = np.zeros((size, size, 3), dtype=np.uint8)
+    gx, gy = corner[0] + x0, corner[1] + y0
+    ax, ay, bx, by = max(gx, 0), max(gy, 0), min(gx + size, w), min(gy + size, h)
+    if ax < bx and ay < by:
+        out[ay - gy:by - gy, ax - gx:bx - gx] = image[ay:by, ax:bx]
+    return out, corner
+
+
+def build_refiner(torch, vocabulary):
+    nn = torch.nn
+    cells = PATCH // CELL
+
+    class Refiner(nn.Module):
+        """A patch (PATCH x PATCH fine pixels) and which point to find in it -> the point's position in
+        the patch (the expectation under a heat map on CELL-pixel cells), its height and the heat map's
+        logits. Dilated convolutions see the whole patch; the instruction and the point's kind scale
+        and shift the third one's channels (FiLM); the height is regressed from the features at the
+        located point."""
+
+        def __init__(self):
+            super().__init__()
+            self.c1, self.n1 = nn.Conv2d(3, 32, 5, 2, 2), nn.BatchNorm2d(32)
+            self.c2, self.n2 = nn.Conv2d(32, 48, 3, 1, 1), nn.BatchNorm2d(48)
+            self.c3, self.n3 = nn.Conv2d(48, 48, 3, 1, 2, dilation=2), nn.BatchNorm2d(48)
+            self.c4, self.n4 = nn.Conv2d(48, 48, 3, 1, 4, dilation=4), nn.BatchNorm2d(48)
+            self.words = nn.EmbeddingBag(vocabulary + 1, 32, mode="mean")
+            self.kinds = nn.Embedding(len(REFINED), 32)
+            self.film = nn.Linear(32, 96)
+            self.located = nn.Conv2d(48, 1, 1)
+            self.height = nn.Sequential(nn.Linear(48 + 32, 64), nn.ReLU(), nn.Linear(64, 1))
+            self.register_buffer("mean", torch.zeros(len(REFINED)))
+            self.register_buffer("spread", torch.ones(len(REFINED)))
+            centres = torch.arange(cells, dtype=torch.float32) * CELL + CELL / 2
+            self.register_buffer("cx", centres.repeat(cells))  # row-major cells: x the column's centre
+            self.register_buffer("cy", centres.repeat_interleave(cells))
+
+        def forward(self, patches, kinds, tokens, offsets):
+            x = (patches.permute(0, 3, 1, 2).float() / 255.0).contiguous(memory_format=torch.channels_last)
+            x = torch.relu(self.n2(self.c2(torch.relu(self.n1(self.c1(x))))))
+            e = self.words(tokens, offsets) + self.kinds(kinds)
+            scale, shift = self.film(e).chunk(2, 1)
+            x = torch.relu(self.n3(self.c3(x)) * (1 + scale[:, :, None, None]) + shift[:, :, None, None])
+            x = torch.relu(self.n4(self.c4(x)))
+            logits = self.located(x).flatten(1)
+            heat = torch.softmax(logits, 1)
+            where = torch.stack([(heat * self.cx).sum(1), (heat * self.cy).sum(1)], 1)
+            at = (x.flatten(2) * heat[:, None]).sum(2)
+            z = self.mean[kinds] + self.spread[kinds] * self.height(torch.cat([at, e], 1))[:, 0]
+            return where, z, logits
+
+    return Refiner()
+
+
+def refine(torch, refiner, images, uv, tokens, offsets):
+    """The REFINED points of each image located again: images (N full images), uv (N x len(REFINED)
+    x 2) the first stage's crop coordinates, the instructions' word indices -> crop coordinates and
+    heights (N x len(REFINED))."""
+    n, k = len(images), len(REFINED)
+    centre = fine_of(uv)
+    kinds = torch.arange(k).repeat(n)
+    index = torch.arange(n).repeat_interleave(k)
+    tokens, offsets = bag_rows(torch, tokens, offsets, index)
+    with torch.no_grad():
+        for _ in range(PASSES):
+            cut = [window(images[i], centre[i, j], PATCH) for i in range(n) for j in range(k)]
+            where, z, _ = refiner(torch.from_numpy(np.stack([c[0] for c in cut])), kinds, tokens, offsets)
+            centre = (np.stack([c[1] for c in cut]) + where.numpy().astype(np.float64)).reshape(n, k, 2)
+    return 2 * centre / FINE - 1, z.numpy().astype(np.float64).reshape(n, k)
+
+
+def bag_rows(torch, tokens, offsets, index):
+    """EmbeddingBag inputs repeating the bags at index."""
+    ends = torch.cat([offsets[1:], torch.tensor([len(tokens)])])
+    rows = [tokens[offsets[i]:ends[i]] for i in index.tolist()]
+    return torch.cat(rows), torch.tensor(np.cumsum([0] + [len(r) for r in rows[:-1]]), dtype=torch.long)
+
+
+def read_windows(pairs, task, rest_weight, valid_every):
+    """The train mask's windows (WINDOW pixels a side) around each frame's REFINED points with their
+    corners, the points' fine crop pixels and heights, and every valid_every-th valid frame whole."""
+    train = {"windows": [], "corners": [], "targets": [], "heights": [], "kinds": [], "weights": [], "instructions": [],
+             "resting": []}
+    valid = {"images": [], "answers": [], "instructions": [], "resting": []}
+    camera, seen = None, 0
+    for mask, frame, y, _, said, resting, camera in episode_frames(pairs, task):
+        if mask == "valid":
+            seen += 1
+            if seen % valid_every == 0:
+                valid["images"].append(frame)
+                valid["answers"].append(y)
+                valid["instructions"].append(said[0])
+                valid["resting"].append(resting)
+            continue
+        for kind, name in enumerate(REFINED):
+            p = y[FIELDS[name][0]:FIELDS[name][0] + 3]
+            target = fine_of(camera.to_crop(p))
+            cut, corner = window(frame, target, WINDOW)
+            train["windows"].append(cut)
+            train["corners"].append(corner)
+            train["targets"].append(target)
+            train["heights"].append(p[2])
+            train["kinds"].append(kind)
+            train["weights"].append(rest_weight if name == "object_position" and resting else 1.0)
+            train["resting"].append(name == "object_position" and resting)
+            train["instructions"].append(said)
+    return train, valid, camera
+
+
+def refined_errors(torch, first, refiner, valid):
+    """Held-out position errors (m) of the end effector (every frame) and of the moved object (at rest,
+    and every frame), by the first stage alone and refined: (median, mean) each."""
+    camera, n = first.model_camera, len(valid["images"])
+    answers = np.asarray(valid["answers"])
+    resting = np.asarray(valid["resting"], dtype=bool)
+    stage, fine = [], []
+    for s in range(0, n, 256):
+        images = valid["images"][s:s + 256]
+        tokens, offsets = encode(torch, valid["instructions"][s:s + 256], first.vocabulary)
+        with torch.no_grad():
+            out = first.model(torch.from_numpy(np.stack([crop(i) for i in images])), tokens, offsets).numpy().astype(np.float64)
+        stage.append(out)
+        uv = np.stack([out[:, ANSWER + 2 * POINTS.index(name):ANSWER + 2 * POINTS.index(name) + 2] for name in REFINED], 1)
+        uv, z = refine(torch, refiner, images, uv, tokens, offsets)
+        fine.append(camera.on_height(torch, torch.from_numpy(uv), torch.from_numpy(z)).numpy())
+    stage, fine = np.concatenate(stage), np.concatenate(fine)
+    errors = {}
+    for kind, name in enumerate(REFINED):
+        c = FIELDS[name][0]
+        for label, rows in (("", np.ones(n, dtype=bool)), (" at rest", resting)):
+            if name == "ee_position" and label:
+                continue
+            a = np.linalg.norm(stage[rows, c:c + 3] - answers[rows, c:c + 3], axis=1)
+            b = np.linalg.norm(fine[rows, kind] - answers[rows, c:c + 3], axis=1)
+            errors[name + label] = {"first stage": (float(np.median(a)), float(a.mean())),
+                                    "refined": (float(np.median(b)), float(b.mean()))}
+    return errors
+
+
+def refine_task(args, task, torch):
+    path = os.path.join(args.out, f"{task}.refine.pt")
+    checkpoint = path + ".checkpoint"
+    first = Perception(os.path.join(args.perception, f"{task}.perception.pt"), torch)
+    train, valid, camera = read_windows(args.data, task, args.rest_weight, args.valid_every)
+    if not train["windows"]:
+        raise ValueError(f"{', '.join(args.data)}: no rendered {task} frames of train-mask episodes")
+    if camera.spec != first.model_camera.spec:
+        raise ValueError(f"{args.perception}/{task}.perception.pt: trained for another camera than {', '.join(args.data)}'s")
+    windows = torch.from_numpy(np.stack(train["windows"]))
+    corners = np.asarray(train["corners"], dtype=np.float64)
+    targets = np.asarray(train["targets"], dtype=np.float64)
+    heights = torch.tensor(train["heights"], dtype=torch.float32)
+    kinds = torch.tensor(train["kinds"])
+    weights = torch.tensor(train["weights"], dtype=torch.float64)
+    torch.manual_seed(args.seed)
+    model = build_refiner(torch, len(first.vocabulary))
+    for kind in range(len(REFINED)):
+        model.mean[kind], model.spread[kind] = heights[kinds == kind].mean(), heights[kinds == kind].std().clamp(min=1e-3)
+    optimiser = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=1e-4)
+    generator = torch.Generator().manual_seed(args.seed)
+    epoch, history = 0, []
+    if args.resume and os.path.exists(checkpoint):
+        epoch, history = rp.resume(torch, checkpoint, model, optimiser, generator, task)
+    print(f"{task}: {len(windows)} train points / {len(valid['images'])} valid frames", flush=True)
+    t0 = time.perf_counter()
+    gamma = args.lr_decay ** (1.0 / max(args.epochs, 1))
+    stop = args.epochs if args.stop_after is None else min(args.epochs, epoch + args.stop_after)
+    span = torch.arange(PATCH)
+    while epoch < stop:
+        for group in optimiser.param_groups:
+            group["lr"] = args.lr * gamma ** epoch
+        model.train()
+        order = torch.multinomial(weights, len(windows), replacement=True, generator=generator)
+        total = 0.0
+        for start in range(0, len(order), args.batch):
+            idx = order[start:start + args.batch]
+            shift = torch.randint(0, WINDOW - PATCH + 1, (len(idx), 2), generator=generator)
+            pick = torch.randint(0, 1 << 30, (len(idx),), generator=generator)
+            rows = (shift[:, 1, None] + span)[:, :, None]
+            cols = (shift[:, 0, None] + span)[:, None, :]
+            patches = windows[idx[:, None, None], rows, cols]
+            goal = torch.from_numpy((targets[idx] - corners[idx]).astype(np.float32)) - shift
+            texts = [train["instructions"][i][p % len(train["instructions"][i])] for i, p in zip(idx.tolist(), pick.tolist())]
+            tokens, offsets = encode(torch, texts, first.vocabulary, args.word_drop, generator)
+            where, z, logits = model(patches, kinds[idx], tokens, offsets)
+            cell = torch.floor(goal / CELL).long().clamp(0, PATCH // CELL - 1)
+            loss = (torch.nn.functional.cross_entropy(logits, cell[:, 1] * (PATCH // CELL) + cell[:, 0])
+                    + (((where - goal) / CELL) ** 2).sum(1).mean() + (((z - heights[idx]) / 0.01) ** 2).mean())
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+            total += loss.item() * len(idx)
+        epoch += 1
+        model.eval()
+        errors = refined_errors(torch, first, model, valid) if valid["images"] else {}
+        history.append((epoch, total / len(windows), None, errors))
+        shown = "".join(f"; {name} {e['first stage'][0] * 100:.1f} -> {e['refined'][0] * 100:.1f} cm median "
+                        f"({e['first stage'][1] * 100:.1f} -> {e['refined'][1] * 100:.1f} mean)" for name, e in errors.items())
+        print(f"{task} refine epoch {epoch}/{args.epochs}: train loss {total / len(windows):.3f}{shown}, "
+              f"{time.perf_counter() - t0:.0f} s", flush=True)
+        rp.write_checkpoint(torch, checkpoint, model, optimiser, generator, epoch, history)
+    if epoch < args.epochs:
+        print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
+        return None
+    rest = heights[torch.tensor(train["resting"], dtype=torch.bool)]
+    rp.save(torch, {"model": model.state_dict(), "vocabulary": first.vocabulary, "task": task, "history": history,
+                    "camera": camera.spec, "rest_height": float(rest.mean()) if len(rest) else float(heights[kinds == 1].mean())}, path)
+    print(f"{task}: refinement -> {path}", flush=True)
+    return model
+
+
+def train_refiners(args):
+    import torch
+    torch.set_num_threads(args.threads)
+    os.makedirs(args.out, exist_ok=True)
+    return {task: refine_task(args, task, torch) for task in args.tasks.split(",")}
+
+
 # ---- acting (evaluate.py: python:manisoft.image_policy:act)
 
 class Perception:
@@ -413,20 +663,41 @@ class Perception:
         saved = torch.load(path)
         self.torch, self.task = torch, saved["task"]
         self.vocabulary, self.assets, self.counts = saved["vocabulary"], saved["assets"], saved["word_counts"]
-        self.model = build_model(torch, len(self.vocabulary), len(self.assets), Camera(saved["camera"]))
+        self.model_camera = Camera(saved["camera"])
+        self.model = build_model(torch, len(self.vocabulary), len(self.assets), self.model_camera)
         self.model.load_state_dict(saved["model"])
         self.model.eval()
+        self.refiner = None
+        refined = path[:-len(".perception.pt")] + ".refine.pt"
+        if os.path.exists(refined):
+            saved = torch.load(refined)
+            if saved["camera"] != self.model_camera.spec or saved["vocabulary"] != self.vocabulary:
+                raise ValueError(f"{refined}: trained beside another perception model than {path}")
+            self.refiner = build_refiner(torch, len(self.vocabulary))
+            self.refiner.load_state_dict(saved["model"])
+            self.refiner.eval()
+            self.rest_height = saved["rest_height"]
         self.reset()
 
     def reset(self):
         self.static, self.asset_logits, self.frames = np.zeros(ANSWER), np.zeros(len(self.assets)), 0
 
-    def __call__(self, image, instruction):
-        """The answer for one image (its static fields averaged over the episode's frames) and the asset."""
+    def __call__(self, image, instruction, resting=False):
+        """The answer for one image (its static fields averaged over the episode's frames) and the
+        asset; resting: the moved object still rests on the table (the policy has not closed the gripper)."""
         torch = self.torch
+        image = np.asarray(image)
         tokens, offsets = encode(torch, [instruction], self.vocabulary)
         with torch.no_grad():
-            out = self.model(torch.from_numpy(crop(np.asarray(image))[None]), tokens, offsets)[0].numpy().astype(np.float64)
+            out = self.model(torch.from_numpy(crop(image)[None]), tokens, offsets)[0].numpy().astype(np.float64)
+        if self.refiner is not None:
+            uv = np.stack([out[ANSWER + 2 * POINTS.index(name):ANSWER + 2 * POINTS.index(name) + 2] for name in REFINED])
+            uv, z = refine(torch, self.refiner, [image], uv[None], tokens, offsets)
+            if resting:  # the moved object on the table: its height is the resting objects' of training
+                z[0, REFINED.index("object_position")] = self.rest_height
+            where = self.model_camera.on_height(torch, torch.from_numpy(uv), torch.from_numpy(z))[0].numpy()
+            for kind, name in enumerate(REFINED):
+                out[FIELDS[name][0]:FIELDS[name][0] + 3] = where[kind]
         self.frames += 1
         self.static += (out[:ANSWER] - self.static) / self.frames
         self.asset_logits += out[HEAD:]
@@ -495,6 +766,7 @@ def load(torch):
 def reset():
     """Called by evaluate.py at the start of every episode: forgets the episode."""
     _episode["instruction"] = _episode["task"] = None
+    _episode["closed"] = False
     for m in list(_perception.values()) + list(_heads.values()):
         m.reset()
 
@@ -513,9 +785,10 @@ def act(obs):
     if task not in _heads:
         _heads[task] = rp.Policy(os.path.join(os.environ["MANISOFT_REFERENCE_MODELS"], f"{task}.pt"), torch)
     head = _heads[task]
-    y, asset = _perception[task](obs["image"], instruction)
-    objects = [pose(y[10:13], y[13:19])] + ([pose(y[19:22], y[22:28])] if task == "COLL" else [])
     s = 0.0 if head.previous is None else float(head.previous[6] >= 0.5)
+    _episode["closed"] = _episode.get("closed", False) or s > 0
+    y, asset = _perception[task](obs["image"], instruction, resting=not _episode["closed"])
+    objects = [pose(y[10:13], y[13:19])] + ([pose(y[19:22], y[22:28])] if task == "COLL" else [])
     seen = {"end_effector": pose(y[0:3], y[3:9]), "gripper_width": max(y[9], 0.0), "gripper_state": s,
             "object_poses": np.stack(objects)}
     return head(seen, Roles(task, y, asset))
@@ -562,11 +835,25 @@ def main(argv=None):
     t.add_argument("--rest-weight", type=float, default=4.0, help="how much more often frames of the moved object at rest are drawn")
     t.add_argument("--word-drop", type=float, default=0.15, help="the chance a training instruction's word is replaced by 'unknown'")
     rp.add_run_flags(t)
+    r = sub.add_parser("refine", help="train one refinement model per task: the end effector and the moved object located "
+                       "again in full-resolution patches (frames rendered at 384 x 384)")
+    r.add_argument("--data", required=True, action="append", help="DATASET_DIR:IMAGES_DIR, as train's, rendered at 384 x 384")
+    r.add_argument("--perception", required=True, help="train's directory: the first stage (<TASK>.perception.pt)")
+    r.add_argument("--out", required=True, help="directory for <TASK>.refine.pt (put it beside <TASK>.perception.pt to use it)")
+    r.add_argument("--tasks", default="COLL")
+    r.add_argument("--epochs", type=int, default=4)
+    r.add_argument("--batch", type=int, default=64)
+    r.add_argument("--lr", type=float, default=1e-3)
+    r.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
+    r.add_argument("--rest-weight", type=float, default=4.0, help="how much more often the moved object at rest is drawn")
+    r.add_argument("--word-drop", type=float, default=0.15, help="the chance a training instruction's word is replaced by 'unknown'")
+    r.add_argument("--valid-every", type=int, default=2, help="every K-th valid frame gives the held-out errors")
+    rp.add_run_flags(r)
     c = sub.add_parser("curves", help="plot the held-out position errors per epoch of trained models")
     c.add_argument("models", nargs="+", help="<TASK>.perception.pt files (or their .checkpoint)")
     c.add_argument("--out", required=True, help="PNG file")
     args = p.parse_args(argv)
-    (train if args.command == "train" else curves)(args)
+    {"train": train, "refine": train_refiners, "curves": curves}[args.command](args)
     return 0
 
 

@@ -1,8 +1,8 @@
 """The image + instruction reference policy (examples/python/image_policy.py) on a tiny dataset
 written by generate_dataset and rendered by render_dataset: the crop is the table region,
-training lowers the loss, the saved model answers as the trained network did, the task is told
-from the instruction, and its act() drives the end-effector track through evaluate.py from the
-image alone."""
+training lowers the loss, the saved model answers as the trained network did, the refinement's
+windows and answers are where the camera puts them, the task is told from the instruction, and its
+act() drives the end-effector track through evaluate.py from the image alone."""
 import json
 import os
 import shutil
@@ -26,11 +26,13 @@ class ImagePolicyTest(unittest.TestCase):
         subprocess.run([os.environ["MANISOFT_GENERATE_DATASET"], "--tasks", "ALN", "--clean", "4", "--randomized", "1",
                         "--seed", "0", "--out", cls.data], check=True, stdout=subprocess.DEVNULL)
         subprocess.run([os.environ["MANISOFT_RENDER_DATASET"], cls.data, "--out", cls.images, "--every", "36",
-                        "--image-size", "192", "192"], check=True, stdout=subprocess.DEVNULL)
+                        "--image-size", "384", "384"], check=True, stdout=subprocess.DEVNULL)
         cls.models = os.path.join(cls.dir, "models")
         cls.args = ["train", "--data", f"{cls.data}:{cls.images}", "--out", cls.models, "--tasks", "ALN", "--epochs", "6",
                     "--batch", "16", "--threads", "1"]
         ip.main(cls.args)
+        ip.main(["refine", "--data", f"{cls.data}:{cls.images}", "--perception", cls.models, "--out", cls.models, "--tasks", "ALN",
+                 "--epochs", "4", "--batch", "16", "--threads", "1", "--valid-every", "1"])
 
     @classmethod
     def tearDownClass(cls):
@@ -61,6 +63,51 @@ class ImagePolicyTest(unittest.TestCase):
         uv = torch.tensor(np.stack([camera.to_crop(p) for p in table])[None])
         back = camera.on_height(torch, uv, torch.tensor(table[None, :, 2]))
         np.testing.assert_allclose(back[0].numpy(), table, atol=1e-12)
+
+    def test_a_window_is_cut_around_a_point_with_zeros_off_the_image(self):
+        image = np.zeros((384, 384, 3), dtype=np.uint8)
+        image[108 + 20, 96 + 10] = 7  # the crop's fine pixel (10, 20): the crop starts at (0.25, 0.28125) of 384
+        image[108 + 20, 0] = 9  # the image's left column: fine pixel -96
+        cut, corner = ip.window(image, (10.5, 20.5), 8)
+        self.assertEqual(corner.tolist(), [6, 16])
+        self.assertEqual(cut[4, 4, 0], 7)
+        self.assertEqual(int(cut[..., 0].sum()), 7)
+        cut, corner = ip.window(image, (-95.0, 20.5), 8)  # three columns left of the image
+        self.assertEqual(corner.tolist(), [-99, 16])
+        self.assertEqual(cut[4, 3, 0], 9)
+        self.assertEqual(int(cut[:, :3].sum()), 0)
+        with self.assertRaisesRegex(ValueError, "refinement reads the crop at 192 x 192 pixels; a 192 x 192 image's is 96 x 96"):
+            ip.window(np.zeros((192, 192, 3), dtype=np.uint8), (0.0, 0.0), 8)
+
+    def test_refinement_lowers_its_loss_and_answers_through_the_camera_ray(self):
+        saved = torch.load(os.path.join(self.models, "ALN.refine.pt"))
+        losses = [train for _, train, _, _ in saved["history"]]
+        self.assertLess(losses[-1], 0.5 * losses[0], losses)
+        loaded = ip.Perception(os.path.join(self.models, "ALN.perception.pt"), torch)
+        self.assertIsNotNone(loaded.refiner)
+        _, image, _, _, said, _, camera = next(ip.episode_frames([f"{self.data}:{self.images}"], "ALN"))
+        instruction = said[0]
+        tokens, offsets = ip.encode(torch, [instruction], loaded.vocabulary)
+        with torch.no_grad():
+            first = loaded.model(torch.from_numpy(ip.crop(image)[None]), tokens, offsets)[0].numpy()
+        uv = np.stack([first[ip.ANSWER + 2 * ip.POINTS.index(n):ip.ANSWER + 2 * ip.POINTS.index(n) + 2] for n in ip.REFINED])
+        fine, z = ip.refine(torch, loaded.refiner, [image], uv[None], tokens, offsets)
+        y, _ = loaded(image, instruction)
+        for kind, name in enumerate(ip.REFINED):
+            # the refined point lies on the camera ray through its crop coordinates, at its height
+            c = ip.FIELDS[name][0]
+            np.testing.assert_allclose(camera.to_crop(y[c:c + 3]), fine[0, kind], atol=1e-9)
+            self.assertAlmostEqual(y[c + 2], z[0, kind], places=9)
+        # the rest of the answer is the first stage's
+        np.testing.assert_allclose(y[ip.FIELDS["width"][0]], first[ip.FIELDS["width"][0]], atol=1e-6)
+        # a refinement trained beside another first stage is refused, naming the files
+        other = os.path.join(self.dir, "other_refine")
+        os.makedirs(other, exist_ok=True)
+        shutil.copy(os.path.join(self.models, "ALN.perception.pt"), other)
+        saved["vocabulary"] = {"another": 1}
+        torch.save(saved, os.path.join(other, "ALN.refine.pt"))
+        with self.assertRaisesRegex(ValueError, "ALN.refine.pt: trained beside another perception model"):
+            ip.Perception(os.path.join(other, "ALN.perception.pt"), torch)
 
     def test_heat_map_cells_of_points(self):
         # the crop's 96 pixels in 24 cells of 4: (0, 0) is pixel 48 across and down, cell 12 of each;
@@ -132,7 +179,7 @@ class ImagePolicyTest(unittest.TestCase):
         os.environ["MANISOFT_REFERENCE_MODELS"], os.environ["MANISOFT_PERCEPTION_MODELS"] = heads, self.models
         out = os.path.join(self.dir, "eval")
         code = evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", "python:image_policy:act", "--action-mode", "ee_pose",
-                              "--image-size", "192", "192", "--indices", "0", "--out", out])
+                              "--image-size", "384", "384", "--indices", "0", "--out", out])
         self.assertEqual(code, 0)
         with open(os.path.join(out, "episodes.jsonl")) as f:
             episodes = [json.loads(line) for line in f if line.strip()]
