@@ -419,7 +419,13 @@ def train(args):
 FINE = 2 * SIZE  # the crop's pixels a side at the resolution refinement reads (a 384 x 384 image)
 PATCH, WINDOW = 48, 88  # a refinement patch; the window kept around a training point (the patch shifts up to 20 pixels)
 CELL = 2  # the refinement heat map's cell, fine pixels
-REFINED = ("ee_position", "object_position")
+HEADED = "second_position"  # ALN's and OVR's marker: its heading is read off the patch too (the marker is upright)
+
+
+def refined_points(task):
+    """The points a task's refinement locates again: the end effector and the moved object; ALN's
+    and OVR's marker (COLL's container is large in the first stage's crop)."""
+    return ("ee_position", "object_position") + (() if task == "COLL" else (HEADED,))
 PASSES = 2  # patches centred first on the first stage's estimate, then on the previous pass's
 
 
@@ -445,7 +451,7 @@ def window(image, centre, size):
     return out, corner
 
 
-def build_refiner(torch, vocabulary):
+def build_refiner(torch, vocabulary, points):
     nn = torch.nn
     cells = PATCH // CELL
 
@@ -454,7 +460,7 @@ def build_refiner(torch, vocabulary):
         the patch (the expectation under a heat map on CELL-pixel cells), its height and the heat map's
         logits. Dilated convolutions see the whole patch; the instruction and the point's kind scale
         and shift the third one's channels (FiLM); the height is regressed from the features at the
-        located point."""
+        located point, and so is the marker's heading (its cosine and sine) where points hold it."""
 
         def __init__(self):
             super().__init__()
@@ -463,15 +469,17 @@ def build_refiner(torch, vocabulary):
             self.c3, self.n3 = nn.Conv2d(48, 48, 3, 1, 2, dilation=2), nn.BatchNorm2d(48)
             self.c4, self.n4 = nn.Conv2d(48, 48, 3, 1, 4, dilation=4), nn.BatchNorm2d(48)
             self.words = nn.EmbeddingBag(vocabulary + 1, 32, mode="mean")
-            self.kinds = nn.Embedding(len(REFINED), 32)
+            self.points = points
+            self.kinds = nn.Embedding(len(points), 32)
             self.film = nn.Linear(32, 96)
             self.located = nn.Conv2d(48, 1, 1)
             self.height = nn.Sequential(nn.Linear(48 + 32, 64), nn.ReLU(), nn.Linear(64, 1))
-            self.register_buffer("mean", torch.zeros(len(REFINED)))
-            self.register_buffer("spread", torch.ones(len(REFINED)))
+            self.register_buffer("mean", torch.zeros(len(points)))
+            self.register_buffer("spread", torch.ones(len(points)))
             centres = torch.arange(cells, dtype=torch.float32) * CELL + CELL / 2
             self.register_buffer("cx", centres.repeat(cells))  # row-major cells: x the column's centre
             self.register_buffer("cy", centres.repeat_interleave(cells))
+            self.heading = nn.Sequential(nn.Linear(48 + 32, 64), nn.ReLU(), nn.Linear(64, 2)) if HEADED in points else None
 
         def forward(self, patches, kinds, tokens, offsets):
             x = (patches.permute(0, 3, 1, 2).float() / 255.0).contiguous(memory_format=torch.channels_last)
@@ -484,17 +492,19 @@ def build_refiner(torch, vocabulary):
             heat = torch.softmax(logits, 1)
             where = torch.stack([(heat * self.cx).sum(1), (heat * self.cy).sum(1)], 1)
             at = (x.flatten(2) * heat[:, None]).sum(2)
-            z = self.mean[kinds] + self.spread[kinds] * self.height(torch.cat([at, e], 1))[:, 0]
-            return where, z, logits
+            features = torch.cat([at, e], 1)
+            z = self.mean[kinds] + self.spread[kinds] * self.height(features)[:, 0]
+            heading = None if self.heading is None else self.heading(features)
+            return where, z, logits, heading
 
     return Refiner()
 
 
 def refine(torch, refiner, images, uv, tokens, offsets):
-    """The REFINED points of each image located again: images (N full images), uv (N x len(REFINED)
-    x 2) the first stage's crop coordinates, the instructions' word indices -> crop coordinates and
-    heights (N x len(REFINED))."""
-    n, k = len(images), len(REFINED)
+    """The refiner's points of each image located again: images (N full images), uv (N x k x 2) the
+    first stage's crop coordinates, the instructions' word indices -> crop coordinates, heights
+    (N x k) and the marker's heading (N angles, None without a marker)."""
+    n, k = len(images), len(refiner.points)
     centre = fine_of(uv)
     kinds = torch.arange(k).repeat(n)
     index = torch.arange(n).repeat_interleave(k)
@@ -502,9 +512,12 @@ def refine(torch, refiner, images, uv, tokens, offsets):
     with torch.no_grad():
         for _ in range(PASSES):
             cut = [window(images[i], centre[i, j], PATCH) for i in range(n) for j in range(k)]
-            where, z, _ = refiner(torch.from_numpy(np.stack([c[0] for c in cut])), kinds, tokens, offsets)
+            where, z, _, heading = refiner(torch.from_numpy(np.stack([c[0] for c in cut])), kinds, tokens, offsets)
             centre = (np.stack([c[1] for c in cut]) + where.numpy().astype(np.float64)).reshape(n, k, 2)
-    return 2 * centre / FINE - 1, z.numpy().astype(np.float64).reshape(n, k)
+    if heading is not None:
+        heading = heading.numpy().astype(np.float64).reshape(n, k, 2)[:, refiner.points.index(HEADED)]
+        heading = np.arctan2(heading[:, 1], heading[:, 0])
+    return 2 * centre / FINE - 1, z.numpy().astype(np.float64).reshape(n, k), heading
 
 
 def bag_rows(torch, tokens, offsets, index):
@@ -514,11 +527,16 @@ def bag_rows(torch, tokens, offsets, index):
     return torch.cat(rows), torch.tensor(np.cumsum([0] + [len(r) for r in rows[:-1]]), dtype=torch.long)
 
 
+def heading_of(six_columns):
+    """The heading (rotation about z) of a rotation given by its first two columns."""
+    return np.arctan2(six_columns[1], six_columns[0])
+
+
 def read_windows(pairs, task, rest_weight, valid_every):
-    """The train mask's windows (WINDOW pixels a side) around each frame's REFINED points with their
-    corners, the points' fine crop pixels and heights, and every valid_every-th valid frame whole."""
+    """The train mask's windows (WINDOW pixels a side) around each frame's refined points with their
+    corners, the points' fine crop pixels, heights and headings, and every valid_every-th valid frame whole."""
     train = {"windows": [], "corners": [], "targets": [], "heights": [], "kinds": [], "weights": [], "instructions": [],
-             "resting": []}
+             "resting": [], "headings": []}
     valid = {"images": [], "answers": [], "instructions": [], "resting": []}
     camera, seen = None, 0
     for mask, frame, y, _, said, resting, camera in episode_frames(pairs, task):
@@ -530,7 +548,7 @@ def read_windows(pairs, task, rest_weight, valid_every):
                 valid["instructions"].append(said[0])
                 valid["resting"].append(resting)
             continue
-        for kind, name in enumerate(REFINED):
+        for kind, name in enumerate(refined_points(task)):
             p = y[FIELDS[name][0]:FIELDS[name][0] + 3]
             target = fine_of(camera.to_crop(p))
             cut, corner = window(frame, target, WINDOW)
@@ -541,32 +559,42 @@ def read_windows(pairs, task, rest_weight, valid_every):
             train["kinds"].append(kind)
             train["weights"].append(rest_weight if name == "object_position" and resting else 1.0)
             train["resting"].append(name == "object_position" and resting)
+            train["headings"].append(heading_of(y[FIELDS["second_rotation"][0]:]))
             train["instructions"].append(said)
     return train, valid, camera
 
 
-def refined_errors(torch, first, refiner, valid):
-    """Held-out position errors (m) of the end effector (every frame) and of the moved object (at rest,
-    and every frame), by the first stage alone and refined: (median, mean) each."""
-    camera, n = first.model_camera, len(valid["images"])
+def refined_errors(torch, first, refiner, valid, rest_height):
+    """Held-out errors, by the first stage alone and refined, (median, mean) each: the positions (m)
+    of the end effector (every frame), the moved object (every frame and at rest) and the marker,
+    and the marker's heading (rad). A resting object is placed at rest_height, as when acting."""
+    camera, n, points = first.model_camera, len(valid["images"]), refiner.points
     answers = np.asarray(valid["answers"])
     resting = np.asarray(valid["resting"], dtype=bool)
-    stage, fine = [], []
+    stage, fine, headings = [], [], []
     for s in range(0, n, 256):
         images = valid["images"][s:s + 256]
         tokens, offsets = encode(torch, valid["instructions"][s:s + 256], first.vocabulary)
         with torch.no_grad():
             out = first.model(torch.from_numpy(np.stack([crop(i) for i in images])), tokens, offsets).numpy().astype(np.float64)
         stage.append(out)
-        uv = np.stack([out[:, ANSWER + 2 * POINTS.index(name):ANSWER + 2 * POINTS.index(name) + 2] for name in REFINED], 1)
-        uv, z = refine(torch, refiner, images, uv, tokens, offsets)
+        uv = np.stack([out[:, ANSWER + 2 * POINTS.index(name):ANSWER + 2 * POINTS.index(name) + 2] for name in points], 1)
+        uv, z, heading = refine(torch, refiner, images, uv, tokens, offsets)
+        z[resting[s:s + 256], points.index("object_position")] = rest_height
         fine.append(camera.on_height(torch, torch.from_numpy(uv), torch.from_numpy(z)).numpy())
+        headings.append(heading)
     stage, fine = np.concatenate(stage), np.concatenate(fine)
     errors = {}
-    for kind, name in enumerate(REFINED):
+    if HEADED in points:
+        c = FIELDS["second_rotation"][0]
+        truth = heading_of(answers[:, c:c + 2].T)
+        a = np.abs(np.angle(np.exp(1j * (heading_of(stage[:, c:c + 2].T) - truth))))
+        b = np.abs(np.angle(np.exp(1j * (np.concatenate(headings) - truth))))
+        errors["marker heading"] = {"first stage": (float(np.median(a)), float(a.mean())), "refined": (float(np.median(b)), float(b.mean()))}
+    for kind, name in enumerate(points):
         c = FIELDS[name][0]
         for label, rows in (("", np.ones(n, dtype=bool)), (" at rest", resting)):
-            if name == "ee_position" and label:
+            if name != "object_position" and label:
                 continue
             a = np.linalg.norm(stage[rows, c:c + 3] - answers[rows, c:c + 3], axis=1)
             b = np.linalg.norm(fine[rows, kind] - answers[rows, c:c + 3], axis=1)
@@ -590,9 +618,14 @@ def refine_task(args, task, torch):
     heights = torch.tensor(train["heights"], dtype=torch.float32)
     kinds = torch.tensor(train["kinds"])
     weights = torch.tensor(train["weights"], dtype=torch.float64)
+    rest = heights[torch.tensor(train["resting"], dtype=torch.bool)]
+    rest_height = float(rest.mean()) if len(rest) else float(heights[kinds == 1].mean())  # the table's top
     torch.manual_seed(args.seed)
-    model = build_refiner(torch, len(first.vocabulary))
-    for kind in range(len(REFINED)):
+    points = refined_points(task)
+    model = build_refiner(torch, len(first.vocabulary), points)
+    headings = torch.tensor(np.stack([np.cos(train["headings"]), np.sin(train["headings"])], 1), dtype=torch.float32)
+    headed = kinds == points.index(HEADED) if HEADED in points else torch.zeros(len(kinds), dtype=torch.bool)
+    for kind in range(len(points)):
         model.mean[kind], model.spread[kind] = heights[kinds == kind].mean(), heights[kinds == kind].std().clamp(min=1e-3)
     optimiser = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=1e-4)
     generator = torch.Generator().manual_seed(args.seed)
@@ -620,29 +653,31 @@ def refine_task(args, task, torch):
             goal = torch.from_numpy((targets[idx] - corners[idx]).astype(np.float32)) - shift
             texts = [train["instructions"][i][p % len(train["instructions"][i])] for i, p in zip(idx.tolist(), pick.tolist())]
             tokens, offsets = encode(torch, texts, first.vocabulary, args.word_drop, generator)
-            where, z, logits = model(patches, kinds[idx], tokens, offsets)
+            where, z, logits, heading = model(patches, kinds[idx], tokens, offsets)
             cell = torch.floor(goal / CELL).long().clamp(0, PATCH // CELL - 1)
             loss = (torch.nn.functional.cross_entropy(logits, cell[:, 1] * (PATCH // CELL) + cell[:, 0])
                     + (((where - goal) / CELL) ** 2).sum(1).mean() + (((z - heights[idx]) / 0.01) ** 2).mean())
+            if heading is not None:  # the heading's cosine and sine, in units of 0.1
+                loss = loss + (headed[idx, None] * ((heading - headings[idx]) / 0.1) ** 2).sum(1).mean()
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
             total += loss.item() * len(idx)
         epoch += 1
         model.eval()
-        errors = refined_errors(torch, first, model, valid) if valid["images"] else {}
+        errors = refined_errors(torch, first, model, valid, rest_height) if valid["images"] else {}
         history.append((epoch, total / len(windows), None, errors))
-        shown = "".join(f"; {name} {e['first stage'][0] * 100:.1f} -> {e['refined'][0] * 100:.1f} cm median "
-                        f"({e['first stage'][1] * 100:.1f} -> {e['refined'][1] * 100:.1f} mean)" for name, e in errors.items())
+        shown = "".join(f"; {name} {e['first stage'][0] * u:.1f} -> {e['refined'][0] * u:.1f} {unit} median "
+                        f"({e['first stage'][1] * u:.1f} -> {e['refined'][1] * u:.1f} mean)" for name, e in errors.items()
+                        for u, unit in [(180 / np.pi, "deg") if name == "marker heading" else (100, "cm")])
         print(f"{task} refine epoch {epoch}/{args.epochs}: train loss {total / len(windows):.3f}{shown}, "
               f"{time.perf_counter() - t0:.0f} s", flush=True)
         rp.write_checkpoint(torch, checkpoint, model, optimiser, generator, epoch, history)
     if epoch < args.epochs:
         print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
         return None
-    rest = heights[torch.tensor(train["resting"], dtype=torch.bool)]
     rp.save(torch, {"model": model.state_dict(), "vocabulary": first.vocabulary, "task": task, "history": history,
-                    "camera": camera.spec, "rest_height": float(rest.mean()) if len(rest) else float(heights[kinds == 1].mean())}, path)
+                    "camera": camera.spec, "points": points, "rest_height": rest_height}, path)
     print(f"{task}: refinement -> {path}", flush=True)
     return model
 
@@ -673,7 +708,7 @@ class Perception:
             saved = torch.load(refined)
             if saved["camera"] != self.model_camera.spec or saved["vocabulary"] != self.vocabulary:
                 raise ValueError(f"{refined}: trained beside another perception model than {path}")
-            self.refiner = build_refiner(torch, len(self.vocabulary))
+            self.refiner = build_refiner(torch, len(self.vocabulary), tuple(saved["points"]))
             self.refiner.load_state_dict(saved["model"])
             self.refiner.eval()
             self.rest_height = saved["rest_height"]
@@ -691,13 +726,17 @@ class Perception:
         with torch.no_grad():
             out = self.model(torch.from_numpy(crop(image)[None]), tokens, offsets)[0].numpy().astype(np.float64)
         if self.refiner is not None:
-            uv = np.stack([out[ANSWER + 2 * POINTS.index(name):ANSWER + 2 * POINTS.index(name) + 2] for name in REFINED])
-            uv, z = refine(torch, self.refiner, [image], uv[None], tokens, offsets)
+            points = self.refiner.points
+            uv = np.stack([out[ANSWER + 2 * POINTS.index(name):ANSWER + 2 * POINTS.index(name) + 2] for name in points])
+            uv, z, heading = refine(torch, self.refiner, [image], uv[None], tokens, offsets)
             if resting:  # the moved object on the table: its height is the resting objects' of training
-                z[0, REFINED.index("object_position")] = self.rest_height
+                z[0, points.index("object_position")] = self.rest_height
             where = self.model_camera.on_height(torch, torch.from_numpy(uv), torch.from_numpy(z))[0].numpy()
-            for kind, name in enumerate(REFINED):
+            for kind, name in enumerate(points):
                 out[FIELDS[name][0]:FIELDS[name][0] + 3] = where[kind]
+            if heading is not None:  # the upright marker turned by its heading
+                c = FIELDS["second_rotation"][0]
+                out[c:c + 6] = [np.cos(heading[0]), np.sin(heading[0]), 0.0, -np.sin(heading[0]), np.cos(heading[0]), 0.0]
         self.frames += 1
         self.static += (out[:ANSWER] - self.static) / self.frames
         self.asset_logits += out[HEAD:]
@@ -795,27 +834,46 @@ def act(obs):
 
 
 def curves(args):
-    """The held-out errors of the located points per epoch (from model or checkpoint files' history)."""
+    """The held-out errors per epoch (from model or checkpoint files' history): the first stage's
+    located points (mean distances), and beside them, given refinement files, the refined points'
+    median errors with the first stage's on the same frames (dotted)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
     import torch
-    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=120)
-    for path, style in zip(args.models, ("-", "--", ":", "-.")):
-        saved = torch.load(path)
-        task = saved.get("task", os.path.basename(path).split(".")[0])
-        epochs = [h[0] for h in saved["history"]]
+    saved = [torch.load(path) for path in args.models]
+    refined = [m for m in saved if "points" in m]
+    fig, axes = plt.subplots(1, 2 if refined else 1, figsize=(12.0 if refined else 6.4, 4.0), dpi=120, squeeze=False)
+    styles = ("-", "--", ":", "-.")
+    for m, style in zip([m for m in saved if "points" not in m], styles):
+        epochs = [h[0] for h in m["history"]]
         for name, colour in zip(POINTS, ("C0", "C1", "C2", "C3")):
-            values = [h[3].get(name) for h in saved["history"]]
+            values = [h[3].get(name) for h in m["history"]]
             if all(v is not None for v in values):
-                ax.plot(epochs, [100 * v for v in values], style, color=colour, marker="o", ms=3,
-                        label=f"{task}: {name.replace('_position', '').replace('second', 'container / marker')}")
-    ax.set_xlabel("epoch")
-    ax.set_ylabel("held-out error, cm (mean distance)")
-    ax.set_ylim(bottom=0)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
-    ax.set_title("Image policy's perception: held-out position errors (valid mask)", fontsize=9)
+                axes[0, 0].plot(epochs, [100 * v for v in values], style, color=colour, marker="o", ms=3,
+                                label=f"{m['task']}: {name.replace('_position', '').replace('second', 'container / marker')}")
+    axes[0, 0].set_ylabel("held-out error, cm (mean distance)")
+    axes[0, 0].set_title("First stage (96 x 96 crop): held-out position errors (valid mask)", fontsize=9)
+    colours = {"ee_position": "C0", "object_position": "C1", "object_position at rest": "C4", "second_position": "C2"}
+    for m, style in zip(refined, styles):
+        epochs = [h[0] for h in m["history"]]
+        for name, colour in colours.items():
+            if name in m["history"][-1][3]:
+                values = [h[3][name] for h in m["history"]]
+                label = f"{m['task']}: {name.replace('_position', '').replace('second', 'marker')}"
+                axes[0, 1].plot(epochs, [100 * v["refined"][0] for v in values], style, color=colour, marker="o", ms=3, label=label)
+                axes[0, 1].plot(epochs, [100 * v["first stage"][0] for v in values], ":", color=colour, lw=1)
+    if refined:
+        axes[0, 1].set_ylabel("held-out error, cm (median distance)")
+        axes[0, 1].set_title("Refined in 48 x 48 patches of the 384 x 384 image (dotted: the first stage on the same frames)",
+                             fontsize=8)
+    for ax in axes.flat:
+        ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
+        ax.set_xlabel("epoch")
+        ax.set_ylim(bottom=0)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, ncol=2)
     fig.tight_layout()
     rp.save_figure(fig, args.out)
 
@@ -850,7 +908,7 @@ def main(argv=None):
     r.add_argument("--valid-every", type=int, default=2, help="every K-th valid frame gives the held-out errors")
     rp.add_run_flags(r)
     c = sub.add_parser("curves", help="plot the held-out position errors per epoch of trained models")
-    c.add_argument("models", nargs="+", help="<TASK>.perception.pt files (or their .checkpoint)")
+    c.add_argument("models", nargs="+", help="<TASK>.perception.pt and <TASK>.refine.pt files (or their .checkpoint)")
     c.add_argument("--out", required=True, help="PNG file")
     args = p.parse_args(argv)
     {"train": train, "refine": train_refiners, "curves": curves}[args.command](args)

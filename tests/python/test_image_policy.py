@@ -90,16 +90,31 @@ class ImagePolicyTest(unittest.TestCase):
         tokens, offsets = ip.encode(torch, [instruction], loaded.vocabulary)
         with torch.no_grad():
             first = loaded.model(torch.from_numpy(ip.crop(image)[None]), tokens, offsets)[0].numpy()
-        uv = np.stack([first[ip.ANSWER + 2 * ip.POINTS.index(n):ip.ANSWER + 2 * ip.POINTS.index(n) + 2] for n in ip.REFINED])
-        fine, z = ip.refine(torch, loaded.refiner, [image], uv[None], tokens, offsets)
+        uv = np.stack([first[ip.ANSWER + 2 * ip.POINTS.index(n):ip.ANSWER + 2 * ip.POINTS.index(n) + 2] for n in loaded.refiner.points])
+        fine, z, heading = ip.refine(torch, loaded.refiner, [image], uv[None], tokens, offsets)
         y, _ = loaded(image, instruction)
-        for kind, name in enumerate(ip.REFINED):
+        for kind, name in enumerate(loaded.refiner.points):
             # the refined point lies on the camera ray through its crop coordinates, at its height
             c = ip.FIELDS[name][0]
             np.testing.assert_allclose(camera.to_crop(y[c:c + 3]), fine[0, kind], atol=1e-9)
             self.assertAlmostEqual(y[c + 2], z[0, kind], places=9)
+        # the marker is upright, turned by the refined heading
+        c = ip.FIELDS["second_rotation"][0]
+        np.testing.assert_allclose(y[c:c + 6], [np.cos(heading[0]), np.sin(heading[0]), 0, -np.sin(heading[0]), np.cos(heading[0]), 0],
+                                   atol=1e-12)
         # the rest of the answer is the first stage's
         np.testing.assert_allclose(y[ip.FIELDS["width"][0]], first[ip.FIELDS["width"][0]], atol=1e-6)
+        # the held-out errors: the first stage's end effector error recomputed here
+        frames = list(ip.episode_frames([f"{self.data}:{self.images}"], "ALN"))[:12]
+        valid = {"images": [f[1] for f in frames], "answers": [f[2] for f in frames], "instructions": [f[4][0] for f in frames],
+                 "resting": [f[5] for f in frames]}
+        errors = ip.refined_errors(torch, loaded, loaded.refiner, valid, loaded.rest_height)
+        self.assertEqual(set(errors), {"marker heading", "ee_position", "object_position", "object_position at rest", "second_position"})
+        tokens, offsets = ip.encode(torch, valid["instructions"], loaded.vocabulary)
+        with torch.no_grad():
+            out = loaded.model(torch.from_numpy(np.stack([ip.crop(i) for i in valid["images"]])), tokens, offsets).numpy()
+        ee = np.linalg.norm(out[:, 0:3] - np.asarray(valid["answers"])[:, 0:3], axis=1)
+        self.assertAlmostEqual(errors["ee_position"]["first stage"][0], float(np.median(ee)), places=5)
         # a refinement trained beside another first stage is refused, naming the files
         other = os.path.join(self.dir, "other_refine")
         os.makedirs(other, exist_ok=True)
