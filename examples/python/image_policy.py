@@ -6,10 +6,11 @@ trained model acts on it. It sees what the paper's policies see, the image and t
 plus its own previous commands.
 
     generate_dataset --tasks ALN,COLL --clean 1000 --randomized 1000 --seed 1 --out data/ref2
-    render_dataset data/ref2 --out img/ref2 --every 36 --image-size 192 192
+    render_dataset data/ref2 --out img/ref2 --every 36 --image-size 384 384
     /usr/bin/python3 -m manisoft.image_policy train --data data/ref2:img/ref2 --tasks ALN,COLL --out img/models
+    /usr/bin/python3 -m manisoft.image_policy refine --data data/ref2:img/ref2 --perception img/models --tasks ALN,COLL --out img/models
     MANISOFT_REFERENCE_MODELS=ref/models MANISOFT_PERCEPTION_MODELS=img/models /usr/bin/python3 -m manisoft.evaluate \\
-        --task ALN --setting all --policy python:manisoft.image_policy:act --action-mode ee_pose --image-size 192 192 --out img/eval
+        --task ALN --setting all --policy python:manisoft.image_policy:act --action-mode ee_pose --image-size 384 384 --out img/eval
 
 Perception: the image's table region (CROP, fractions of the image) at 96 x 96 pixels with two
 coordinate channels; four convolutions, the instruction's words (a bag of embeddings) scaling and
@@ -27,6 +28,12 @@ a spread-out map stuck between candidates) and of the asset. Frames before the g
 moved object rests on the table, are drawn --rest-weight times as often. Each frame's instruction
 is drawn from the episode's canonical and seen ones, a word dropped at random (unseen paraphrases
 use words training never saw).
+Refinement (refine; used where <TASK>.refine.pt lies beside <TASK>.perception.pt): the end effector,
+the moved object and ALN's and OVR's marker are located again in PATCH x PATCH patches of the 384 x
+384 image centred on the first stage's estimate (twice, the second centred on the first's answer):
+a heat map on CELL-pixel cells, the height and the marker's heading regressed from the features at
+the located point. While the policy has not closed the gripper the moved object rests on the
+table, at the height of training's resting objects.
 Acting: the static parts of the scene (the container or goal, the obstacle, the asset) are averaged
 over the episode's frames so far; the end effector, the fingers and the moved object are read from
 the current frame; S is the policy's own last command. The task is the one whose training
@@ -618,7 +625,7 @@ def refine_task(args, task, torch):
     heights = torch.tensor(train["heights"], dtype=torch.float32)
     kinds = torch.tensor(train["kinds"])
     weights = torch.tensor(train["weights"], dtype=torch.float64)
-    rest = heights[torch.tensor(train["resting"], dtype=torch.bool)]
+    rest = heights[torch.tensor([bool(r) for r in train["resting"]])]
     rest_height = float(rest.mean()) if len(rest) else float(heights[kinds == 1].mean())  # the table's top
     torch.manual_seed(args.seed)
     points = refined_points(task)
