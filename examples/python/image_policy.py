@@ -35,7 +35,7 @@ a heat map on CELL-pixel cells, the height and the marker's heading regressed fr
 the located point. While the policy has not closed the gripper the moved object rests on the
 table, at the height of training's resting objects.
 Acting: the static parts of the scene (the container or goal, the obstacle, the asset) are averaged
-over the episode's frames so far; the end effector, the fingers and the moved object are read from
+over the episode's frames so far (a refined marker: the median); the end effector, the fingers and the moved object are read from
 the current frame; S is the policy's own last command. The task is the one whose training
 instructions make the instruction's words likeliest (naive Bayes over the words).
 """
@@ -411,14 +411,11 @@ def train_task(args, task, torch):
     return model
 
 
-def train(args):
-    import torch
-    torch.set_num_threads(args.threads)
+def train(args, train_one=None):
     for pair in args.data:
         if ":" not in pair:
             raise SystemExit(f"image_policy: --data {pair}: expected DATASET_DIR:IMAGES_DIR")
-    os.makedirs(args.out, exist_ok=True)
-    return {task: train_task(args, task, torch) for task in args.tasks.split(",")}
+    return rp.train(args, train_one or train_task)
 
 
 # ---- refinement: the end effector and the moved object located again at full resolution
@@ -690,10 +687,7 @@ def refine_task(args, task, torch):
 
 
 def train_refiners(args):
-    import torch
-    torch.set_num_threads(args.threads)
-    os.makedirs(args.out, exist_ok=True)
-    return {task: refine_task(args, task, torch) for task in args.tasks.split(",")}
+    return train(args, refine_task)
 
 
 # ---- acting (evaluate.py: python:manisoft.image_policy:act)
@@ -723,9 +717,11 @@ class Perception:
 
     def reset(self):
         self.static, self.asset_logits, self.frames = np.zeros(ANSWER), np.zeros(len(self.assets)), 0
+        self.markers = []  # the refined marker's position and heading in each frame so far
 
     def __call__(self, image, instruction, resting=False):
-        """The answer for one image (its static fields averaged over the episode's frames) and the
+        """The answer for one image (its static fields averaged over the episode's frames, a refined
+        marker's position and heading their median) and the
         asset; resting: the moved object still rests on the table (the policy has not closed the gripper)."""
         torch = self.torch
         image = np.asarray(image)
@@ -742,8 +738,7 @@ class Perception:
             for kind, name in enumerate(points):
                 out[FIELDS[name][0]:FIELDS[name][0] + 3] = where[kind]
             if heading is not None:  # the upright marker turned by its heading
-                c = FIELDS["second_rotation"][0]
-                out[c:c + 6] = [np.cos(heading[0]), np.sin(heading[0]), 0.0, -np.sin(heading[0]), np.cos(heading[0]), 0.0]
+                self.markers.append(np.r_[where[points.index(HEADED)], np.cos(heading[0]), np.sin(heading[0])])
         self.frames += 1
         self.static += (out[:ANSWER] - self.static) / self.frames
         self.asset_logits += out[HEAD:]
@@ -751,6 +746,12 @@ class Perception:
         for name in STATIC:
             c, n, _ = FIELDS[name]
             y[c:c + n] = self.static[c:c + n]
+        if self.markers:  # the refined marker: the median over the frames (a frame whose first stage missed it is far off)
+            m = np.median(self.markers, axis=0)
+            heading = np.arctan2(m[4], m[3])
+            y[FIELDS["second_position"][0]:FIELDS["second_position"][0] + 3] = m[:3]
+            c = FIELDS["second_rotation"][0]
+            y[c:c + 6] = [np.cos(heading), np.sin(heading), 0.0, -np.sin(heading), np.cos(heading), 0.0]
         return y, self.assets[int(np.argmax(self.asset_logits))]
 
 def task_of(instruction, models):

@@ -355,11 +355,12 @@ def train_task(args, task, torch):
     return model
 
 
-def train(args):
+def train(args, train_one=None):
+    """train_one(args, task, torch) (default: this module's train_task) for each of --tasks."""
     import torch
     torch.set_num_threads(args.threads)
     os.makedirs(args.out, exist_ok=True)
-    return {task: train_task(args, task, torch) for task in args.tasks.split(",")}
+    return {task: (train_one or train_task)(args, task, torch) for task in args.tasks.split(",")}
 
 
 # ---- acting (evaluate.py: python:manisoft.reference_policy:act)
