@@ -372,11 +372,7 @@ def train_task(args, task, torch):
         return loss_of(torch, out, va, vp, vid, scales).item(), errors
 
     t0 = time.perf_counter()
-    gamma = args.lr_decay ** (1.0 / max(args.epochs, 1))
-    stop = args.epochs if args.stop_after is None else min(args.epochs, epoch + args.stop_after)
-    while epoch < stop:
-        for group in optimiser.param_groups:
-            group["lr"] = args.lr * gamma ** epoch
+    for epoch in rp.scheduled_epochs(args, epoch, optimiser):
         model.train()
         # frames of the object at rest drawn --rest-weight times as often: the moved object is held
         # for most of an episode, and a network that follows the hand is wrong only before the grasp
@@ -393,7 +389,6 @@ def train_task(args, task, torch):
             loss.backward()
             optimiser.step()
             total += loss.item() * len(idx)
-        epoch += 1
         model.eval()
         held_out, errors = valid_pass()
         history.append((epoch, total / len(images), held_out, errors))
@@ -402,8 +397,7 @@ def train_task(args, task, torch):
         print(f"{task} epoch {epoch}/{args.epochs}: train loss {total / len(images):.3f}{shown}, "
               f"{time.perf_counter() - t0:.0f} s", flush=True)
         rp.write_checkpoint(torch, checkpoint, model, optimiser, generator, epoch, history)
-    if epoch < args.epochs:
-        print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
+    if rp.stopped_early(args, epoch, task):
         return None
     rp.save(torch, {"model": model.state_dict(), "vocabulary": vocabulary, "assets": assets, "task": task, "history": history,
                     "word_counts": counts, "camera": data["camera"].spec}, path)
@@ -423,6 +417,7 @@ def train(args, train_one=None):
 FINE = 2 * SIZE  # the crop's pixels a side at the resolution refinement reads (a 384 x 384 image)
 PATCH, WINDOW = 48, 88  # a refinement patch; the window kept around a training point (the patch shifts up to 20 pixels)
 CELL = 2  # the refinement heat map's cell, fine pixels
+PASSES = 2  # patches centred first on the first stage's estimate, then on the previous pass's
 HEADED = "second_position"  # ALN's and OVR's marker: its heading is read off the patch too (the marker is upright)
 
 
@@ -430,7 +425,6 @@ def refined_points(task):
     """The points a task's refinement locates again: the end effector and the moved object; ALN's
     and OVR's marker (COLL's container is large in the first stage's crop)."""
     return ("ee_position", "object_position") + (() if task == "COLL" else (HEADED,))
-PASSES = 2  # patches centred first on the first stage's estimate, then on the previous pass's
 
 
 def fine_of(uv):
@@ -638,12 +632,8 @@ def refine_task(args, task, torch):
         epoch, history = rp.resume(torch, checkpoint, model, optimiser, generator, task)
     print(f"{task}: {len(windows)} train points / {len(valid['images'])} valid frames", flush=True)
     t0 = time.perf_counter()
-    gamma = args.lr_decay ** (1.0 / max(args.epochs, 1))
-    stop = args.epochs if args.stop_after is None else min(args.epochs, epoch + args.stop_after)
     span = torch.arange(PATCH)
-    while epoch < stop:
-        for group in optimiser.param_groups:
-            group["lr"] = args.lr * gamma ** epoch
+    for epoch in rp.scheduled_epochs(args, epoch, optimiser):
         model.train()
         order = torch.multinomial(weights, len(windows), replacement=True, generator=generator)
         total = 0.0
@@ -667,7 +657,6 @@ def refine_task(args, task, torch):
             loss.backward()
             optimiser.step()
             total += loss.item() * len(idx)
-        epoch += 1
         model.eval()
         errors = refined_errors(torch, first, model, valid, rest_height) if valid["images"] else {}
         history.append((epoch, total / len(windows), None, errors))
@@ -677,8 +666,7 @@ def refine_task(args, task, torch):
         print(f"{task} refine epoch {epoch}/{args.epochs}: train loss {total / len(windows):.3f}{shown}, "
               f"{time.perf_counter() - t0:.0f} s", flush=True)
         rp.write_checkpoint(torch, checkpoint, model, optimiser, generator, epoch, history)
-    if epoch < args.epochs:
-        print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
+    if rp.stopped_early(args, epoch, task):
         return None
     rp.save(torch, {"model": model.state_dict(), "vocabulary": first.vocabulary, "task": task, "history": history,
                     "camera": camera.spec, "points": points, "rest_height": rest_height}, path)

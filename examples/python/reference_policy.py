@@ -302,6 +302,25 @@ def add_run_flags(parser):
                         "job), leaving the checkpoint for --resume")
 
 
+def scheduled_epochs(args, epoch, optimiser):
+    """The epochs this run trains, from a resumed run's epoch to --epochs (or --stop-after more), each
+    with its learning rate set first (falling by --lr-decay over the whole schedule): yields each
+    epoch's number as it will be once trained (1-based)."""
+    gamma = args.lr_decay ** (1.0 / max(args.epochs, 1))
+    stop = args.epochs if args.stop_after is None else min(args.epochs, epoch + args.stop_after)
+    for e in range(epoch, stop):
+        for group in optimiser.param_groups:
+            group["lr"] = args.lr * gamma ** e
+        yield e + 1
+
+
+def stopped_early(args, epoch, task):
+    """Whether --stop-after ended the run before --epochs (said; --resume goes on)."""
+    if epoch < args.epochs:
+        print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
+    return epoch < args.epochs
+
+
 def train_task(args, task, torch):
     path = os.path.join(args.out, f"{task}.pt")
     checkpoint = path + ".checkpoint"
@@ -322,11 +341,7 @@ def train_task(args, task, torch):
         epoch, history = resume(torch, checkpoint, model, optimiser, generator, task)
     print(f"{task}: {counts['train']} train / {counts['valid']} valid episodes, {len(x)} samples of {x.shape[1]} inputs", flush=True)
     t0 = time.perf_counter()
-    scheduler_gamma = args.lr_decay ** (1.0 / max(args.epochs, 1))
-    stop = args.epochs if args.stop_after is None else min(args.epochs, epoch + args.stop_after)
-    while epoch < stop:
-        for group in optimiser.param_groups:
-            group["lr"] = args.lr * scheduler_gamma ** epoch
+    for epoch in scheduled_epochs(args, epoch, optimiser):
         model.train()
         order = torch.randperm(len(xn), generator=generator)
         total = 0.0
@@ -337,7 +352,6 @@ def train_task(args, task, torch):
             loss.backward()
             optimiser.step()
             total += loss.item() * len(idx)
-        epoch += 1
         model.eval()
         with torch.no_grad():
             held_out = loss_of(torch, model(valid[0]), valid[1], valid[2]).item() if valid else None
@@ -346,8 +360,7 @@ def train_task(args, task, torch):
         print(f"{task} epoch {epoch}/{args.epochs}: train loss {total / len(xn):.4f}, held-out loss {shown}, "
               f"{time.perf_counter() - t0:.0f} s", flush=True)
         write_checkpoint(torch, checkpoint, model, optimiser, generator, epoch, history)
-    if epoch < args.epochs:
-        print(f"{task}: stopped after epoch {epoch} (--stop-after); --resume goes on", flush=True)
+    if stopped_early(args, epoch, task):
         return None
     save(torch, {"model": model.state_dict(), "inputs": x.shape[1], "width": args.width, "depth": args.depth,
                  "norm": norm.state(), "assets": assets, "task": task, "history": history, "repeat": args.repeat}, path)
