@@ -148,9 +148,10 @@ def points_of(camera, y):
     return np.stack([camera.to_crop(y[FIELDS[name][0]:FIELDS[name][0] + 3]) for name in POINTS])
 
 
-def episode_frames(pairs, task):
-    """Every rendered frame of the task's episodes, as (mask, image, answer, asset, the episode's
-    instructions, whether the moved object still rests (before the grasp), camera)."""
+def rendered_episodes(pairs, task):
+    """The task's rendered episodes, as (mask, scene, the recorded arrays (eef_pose, gripper,
+    object_poses, ee_target), the frames, their control steps, the episode's instructions (the
+    canonical one first, then the seen ones), camera)."""
     import h5py
     camera = None
     for pair in pairs:
@@ -172,18 +173,26 @@ def episode_frames(pairs, task):
                     camera = Camera(scene["cameras"][0])
                 elif Camera(scene["cameras"][0]).spec != camera.spec:
                     raise ValueError(f"{data}: {demo}'s camera differs from the other episodes' (the policy reads one view)")
-                eef, grip, obj = (g["obs"][k][()].astype(np.float64) for k in ("eef_pose", "gripper", "object_poses"))
-                if len(steps) and steps.max() >= len(eef):
-                    raise ValueError(f"{path}: a frame at step {steps.max()}, but {data}'s {demo} has {len(eef)} steps "
-                                     "(images of another dataset?)")
-                obj = obj.reshape(len(obj), -1, 7)
+                arrays = {k: g["obs"][k][()].astype(np.float64) for k in ("eef_pose", "gripper", "object_poses", "ee_target")}
+                if len(steps) and steps.max() >= len(arrays["eef_pose"]):
+                    raise ValueError(f"{path}: a frame at step {steps.max()}, but {data}'s {demo} has {len(arrays['eef_pose'])} "
+                                     "steps (images of another dataset?)")
                 said = [str(g.attrs["instruction"])] + json.loads(g.attrs["instructions_seen"])
-                closed = np.flatnonzero(grip[:, 1] >= 0.5)
-                grasp = closed[0] if len(closed) else len(grip)  # the moved object rests on the table before
                 mask = "train" if demo in masks["train"] else "valid"
-                for frame, step in zip(frames, steps):
-                    y, asset = labels_of(scene, eef[step], grip[step], obj[step])
-                    yield mask, frame, y, asset, said, step < grasp, camera
+                yield mask, scene, arrays, frames, steps, said, camera
+
+
+def episode_frames(pairs, task):
+    """Every rendered frame of the task's episodes, as (mask, image, answer, asset, the episode's
+    instructions, whether the moved object still rests (before the grasp), camera)."""
+    for mask, scene, a, frames, steps, said, camera in rendered_episodes(pairs, task):
+        eef, grip = a["eef_pose"], a["gripper"]
+        obj = a["object_poses"].reshape(len(eef), -1, 7)
+        closed = np.flatnonzero(grip[:, 1] >= 0.5)
+        grasp = closed[0] if len(closed) else len(grip)  # the moved object rests on the table before
+        for frame, step in zip(frames, steps):
+            y, asset = labels_of(scene, eef[step], grip[step], obj[step])
+            yield mask, frame, y, asset, said, step < grasp, camera
 
 
 def read_frames(pairs, task):
@@ -678,6 +687,57 @@ def train_refiners(args):
     return train(args, refine_task)
 
 
+def perceived_reads(pairs, task, perception, repeat):
+    """Perception.read of each rendered episode of the task: (mask, the recorded arrays, the frames'
+    control steps, the episode's canonical instruction, read's rows)."""
+    for mask, _, a, frames, steps, said, _ in rendered_episodes(pairs, task):
+        if len(steps) and (steps[0] != 0 or np.any(np.diff(steps) != repeat)):
+            raise ValueError(f"{task} frames at steps {', '.join(map(str, steps[:3]))}, ...: the head acts every {repeat} "
+                             f"control steps from step 0; render with render_dataset --every {repeat}")
+        yield mask, a, steps, said[0], perception.read(frames, said[0])
+
+
+def perceived_rows(reads, perception, head):
+    """The head's training rows with the state perception read off each rendered frame (reads:
+    perceived_reads'), as when acting: an episode's frames folded in order, the moved object resting
+    until the expert's command closes the gripper, seen_observation with the expert's previous
+    command; the memory and the labels from the expert's commands (reference_policy.command_rows).
+    {"train": (inputs, labels), "valid": ...} and the episodes of each mask."""
+    split, counts = {"train": ([], []), "valid": ([], [])}, {"train": 0, "valid": 0}
+    for mask, a, steps, _, (out, refined) in reads:
+        perception.reset()
+        counts[mask] += 1
+        closed, last = False, None
+        for i, (_, previous, change, _, age, count, label) in enumerate(rp.command_rows(a, steps, head["repeat"])):
+            s = float(previous[6] >= 0.5)
+            closed = closed or s > 0
+            y, asset = perception.fold(out[i], refined and tuple(None if r is None else r[i] for r in refined), not closed)
+            seen, roles = seen_observation(perception, y, asset, s, previous if i else None)
+            ee = seen["end_effector"][:3, 3]
+            moved = np.zeros(3) if last is None else ee - last
+            split[mask][0].append(rp.observed_features(seen, roles, (previous, change, moved, age, count), head["assets"]))
+            split[mask][1].append(label)
+            last = ee
+    return {m: (np.asarray(x, dtype=np.float32), np.asarray(y, dtype=np.float32)) for m, (x, y) in split.items() if x}, counts
+
+
+def adapt_task(args, task, torch):
+    head = torch.load(os.path.join(args.reference, f"{task}.pt"))
+    head["norm"] = rp.Normaliser.of_state(head["norm"]).constant_in_own_units().state()
+    perception = Perception(os.path.join(args.perception, f"{task}.perception.pt"), torch)
+    t0 = time.perf_counter()
+    data, counts = perceived_rows(perceived_reads(args.data, task, perception, head["repeat"]), perception, head)
+    if "train" not in data:
+        raise ValueError(f"{', '.join(args.data)}: no rendered {task} frames of train-mask episodes")
+    print(f"{task}: {counts['train']} train / {counts['valid']} valid episodes, {len(data['train'][0])} train frames read "
+          f"in {time.perf_counter() - t0:.0f} s", flush=True)
+    return rp.fit(args, task, torch, data, os.path.join(args.out, f"{task}.head.pt"), head)
+
+
+def adapt_heads(args):
+    return train(args, adapt_task)
+
+
 # ---- acting (evaluate.py: python:manisoft.image_policy:act)
 
 class Perception:
@@ -707,26 +767,40 @@ class Perception:
         self.static, self.asset_logits, self.frames = np.zeros(ANSWER), np.zeros(len(self.assets)), 0
         self.markers = []  # the refined marker's position and heading in each frame so far
 
-    def __call__(self, image, instruction, resting=False):
-        """The answer for one image (its static fields averaged over the episode's frames, a refined
-        marker's position and heading their median) and the
-        asset; resting: the moved object still rests on the table (the policy has not closed the gripper)."""
+    def read(self, images, instruction):
+        """Both stages' networks on the images (frames of one episode, batched): the first stage's rows
+        (N x HEAD) and, with a refinement, the refined points' positions (N x k x 3), the moved
+        object's on its ray at the resting height (N x 3) and the marker's headings (N, or None)."""
         torch = self.torch
-        image = np.asarray(image)
-        tokens, offsets = encode(torch, [instruction], self.vocabulary)
+        images = [np.asarray(i) for i in images]
+        tokens, offsets = encode(torch, [instruction] * len(images), self.vocabulary)
         with torch.no_grad():
-            out = self.model(torch.from_numpy(crop(image)[None]), tokens, offsets)[0].numpy().astype(np.float64)
-        if self.refiner is not None:
+            out = self.model(torch.from_numpy(np.stack([crop(i) for i in images])), tokens, offsets).numpy().astype(np.float64)
+        if self.refiner is None:
+            return out, None
+        points = self.refiner.points
+        uv = np.stack([out[:, ANSWER + 2 * POINTS.index(name):ANSWER + 2 * POINTS.index(name) + 2] for name in points], 1)
+        uv, z, heading = refine(torch, self.refiner, images, uv, tokens, offsets)
+        where = self.model_camera.on_height(torch, torch.from_numpy(uv), torch.from_numpy(z)).numpy()
+        k = points.index("object_position")
+        at_rest = self.model_camera.on_height(torch, torch.from_numpy(uv[:, k:k + 1]),
+                                              torch.full((len(images), 1), self.rest_height, dtype=torch.float64)).numpy()[:, 0]
+        return out, (where, at_rest, heading)
+
+    def fold(self, out, refined, resting):
+        """One frame's answer from read's rows for it, the episode's frames so far folded in: its static
+        fields averaged over the frames, a refined marker's position and heading their median; and the
+        asset. resting: the moved object still rests on the table (the policy has not closed the gripper)."""
+        out = out.copy()
+        if refined is not None:
+            where, at_rest, heading = refined
             points = self.refiner.points
-            uv = np.stack([out[ANSWER + 2 * POINTS.index(name):ANSWER + 2 * POINTS.index(name) + 2] for name in points])
-            uv, z, heading = refine(torch, self.refiner, [image], uv[None], tokens, offsets)
-            if resting:  # the moved object on the table: its height is the resting objects' of training
-                z[0, points.index("object_position")] = self.rest_height
-            where = self.model_camera.on_height(torch, torch.from_numpy(uv), torch.from_numpy(z))[0].numpy()
             for kind, name in enumerate(points):
                 out[FIELDS[name][0]:FIELDS[name][0] + 3] = where[kind]
+            if resting:  # the moved object on the table: its height is the resting objects' of training
+                out[FIELDS["object_position"][0]:FIELDS["object_position"][0] + 3] = at_rest
             if heading is not None:  # the upright marker turned by its heading
-                self.markers.append(np.r_[where[points.index(HEADED)], np.cos(heading[0]), np.sin(heading[0])])
+                self.markers.append(np.r_[where[points.index(HEADED)], np.cos(heading), np.sin(heading)])
         self.frames += 1
         self.static += (out[:ANSWER] - self.static) / self.frames
         self.asset_logits += out[HEAD:]
@@ -741,6 +815,12 @@ class Perception:
             c = FIELDS["second_rotation"][0]
             y[c:c + 6] = [np.cos(heading), np.sin(heading), 0.0, -np.sin(heading), np.cos(heading), 0.0]
         return y, self.assets[int(np.argmax(self.asset_logits))]
+
+    def __call__(self, image, instruction, resting=False):
+        """fold of read of one image."""
+        out, refined = self.read([image], instruction)
+        return self.fold(out[0], refined and tuple(None if r is None else r[0] for r in refined), resting)
+
 
 def task_of(instruction, models):
     """The task whose training instructions make the instruction's words likeliest: naive Bayes,
@@ -786,9 +866,9 @@ _episode = {"instruction": None, "task": None}
 
 def load(torch):
     directory = os.environ.get("MANISOFT_PERCEPTION_MODELS")
-    if not directory or not os.environ.get("MANISOFT_REFERENCE_MODELS"):
-        raise RuntimeError("set MANISOFT_PERCEPTION_MODELS (image_policy.py train's directory) and MANISOFT_REFERENCE_MODELS "
-                           "(reference_policy.py train's directory)")
+    if not directory:
+        raise RuntimeError("set MANISOFT_PERCEPTION_MODELS (image_policy.py train's directory) and, for a task without "
+                           "<TASK>.head.pt there, MANISOFT_REFERENCE_MODELS (reference_policy.py train's directory)")
     paths = sorted(glob.glob(os.path.join(directory, "*.perception.pt")))
     if not paths:
         raise RuntimeError(f"MANISOFT_PERCEPTION_MODELS={directory}: no <TASK>.perception.pt")
@@ -818,15 +898,38 @@ def act(obs):
         _episode["task"] = task_of(instruction, _perception)
     task = _episode["task"]
     if task not in _heads:
-        _heads[task] = rp.Policy(os.path.join(os.environ["MANISOFT_REFERENCE_MODELS"], f"{task}.pt"), torch)
+        adapted = os.path.join(os.environ["MANISOFT_PERCEPTION_MODELS"], f"{task}.head.pt")
+        if not os.path.exists(adapted) and not os.environ.get("MANISOFT_REFERENCE_MODELS"):
+            raise RuntimeError(f"no {adapted}: set MANISOFT_REFERENCE_MODELS (reference_policy.py train's directory)")
+        path = adapted if os.path.exists(adapted) else os.path.join(os.environ["MANISOFT_REFERENCE_MODELS"], f"{task}.pt")
+        _heads[task] = rp.Policy(path, torch)
     head = _heads[task]
     s = 0.0 if head.previous is None else float(head.previous[6] >= 0.5)
     _episode["closed"] = _episode.get("closed", False) or s > 0
     y, asset = _perception[task](obs["image"], instruction, resting=not _episode["closed"])
+    return head(*seen_observation(_perception[task], y, asset, s, head.previous))
+
+
+NEAR = 0.08  # m: the end effector is taken on its camera ray nearest the last command when that point is this close
+
+
+def seen_observation(perception, y, asset, s, previous):
+    """The privileged observation's entries (reference_policy.observed_features) and the scene's
+    roles as perception read them (answer y, asset); S and previous the policy's last command (None
+    before the first). The arm settles at its command and one view places the end effector least
+    well along the camera ray (its height): where the point of the end effector's ray nearest the
+    last command lies within NEAR of the perceived position, the end effector is taken there."""
+    task, ee = perception.task, y[0:3]
+    if previous is not None:
+        origin = perception.model_camera.position
+        ray = (ee - origin) / np.linalg.norm(ee - origin)
+        nearest = origin + ray * ((previous[:3] - origin) @ ray)
+        if np.linalg.norm(nearest - ee) < NEAR:
+            ee = nearest
     objects = [pose(y[10:13], y[13:19])] + ([pose(y[19:22], y[22:28])] if task == "COLL" else [])
-    seen = {"end_effector": pose(y[0:3], y[3:9]), "gripper_width": max(y[9], 0.0), "gripper_state": s,
+    seen = {"end_effector": pose(ee, y[3:9]), "gripper_width": max(y[9], 0.0), "gripper_state": s,
             "object_poses": np.stack(objects)}
-    return head(seen, Roles(task, y, asset))
+    return seen, Roles(task, y, asset)
 
 
 def curves(args):
@@ -897,11 +1000,24 @@ def main(argv=None):
         stage.add_argument("--rest-weight", type=float, default=4.0, help="how much more often frames of the moved object at rest are drawn")
         stage.add_argument("--word-drop", type=float, default=0.15, help="the chance a training instruction's word is replaced by 'unknown'")
         rp.add_run_flags(stage)
+    h = sub.add_parser("adapt", help="train the privileged policy's model further on the state perception reads off the "
+                       "rendered frames (frames every --repeat control steps), as <TASK>.head.pt used beside the perception")
+    h.add_argument("--data", required=True, action="append", help="DATASET_DIR:IMAGES_DIR, as refine's")
+    h.add_argument("--perception", required=True, help="the perception's directory (<TASK>.perception.pt, <TASK>.refine.pt)")
+    h.add_argument("--reference", required=True, help="reference_policy.py train's directory (<TASK>.pt, where it starts)")
+    h.add_argument("--out", required=True, help="directory for <TASK>.head.pt (put it beside <TASK>.perception.pt to use it)")
+    h.add_argument("--tasks", default="ALN")
+    h.add_argument("--epochs", type=int, default=10)
+    h.add_argument("--batch", type=int, default=512)
+    h.add_argument("--lr", type=float, default=3e-4)
+    h.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
+    h.add_argument("--weight-decay", type=float, default=1e-4)
+    rp.add_run_flags(h)
     c = sub.add_parser("curves", help="plot the held-out position errors per epoch of trained models")
     c.add_argument("models", nargs="+", help="<TASK>.perception.pt and <TASK>.refine.pt files (or their .checkpoint)")
     c.add_argument("--out", required=True, help="PNG file")
     args = p.parse_args(argv)
-    {"train": train, "refine": train_refiners, "curves": curves}[args.command](args)
+    {"train": train, "refine": train_refiners, "adapt": adapt_heads, "curves": curves}[args.command](args)
     return 0
 
 

@@ -158,13 +158,13 @@ def read_episodes(directory, task):
     return out
 
 
-def samples_of(episode, stride, repeat, assets):
-    """The episode's training rows at every stride-th step t: the inputs with the command sent at
-    t - repeat as the previous one; whether the expert's command changed since (the switch label);
-    the command after the previous one (the next command), as a change from it."""
-    _, scene, a = episode
-    roles = SceneRoles(scene)
-    eef, grip, objects, target = a["eef_pose"], a["gripper"], a["object_poses"], a["ee_target"]
+def command_rows(a, steps_at, repeat):
+    """The expert's commands (a["ee_target"]) as the policy's memory at each step t of steps_at, with
+    the command sent at t - repeat as the previous one: (t, the previous command, its change from the
+    one before, the step of the previous call, the control steps since the previous command was first
+    sent, the commands since S last changed, the label: the command after the previous one (the next
+    command) as a change from it, its S and whether the expert's command changed since (the switch))."""
+    target = a["ee_target"]
     steps = len(target)
     # the commands: a new one wherever the target or S changes (obs/ee_waypoint counts pose changes only)
     waypoint = np.concatenate([[0], np.cumsum(np.any(target[1:] != target[:-1], axis=1))])
@@ -174,25 +174,36 @@ def samples_of(episode, stride, repeat, assets):
     for w in range(1, len(s_of)):
         moves[w] = 0 if s_of[w] != s_of[w - 1] else moves[w - 1] + 1
     first = np.searchsorted(waypoint, np.arange(waypoint[-1] + 2))  # first step of each waypoint (steps if none)
-    k = objects.shape[1] // 7
-    objects = objects.reshape(steps, k, 7)
-    ee_rot = rotation_of_quaternion(eef[:, 3:])
-    obj_rot = rotation_of_quaternion(objects[..., 3:])
-    xs, ys = [], []
-    for t in range(0, steps, stride):
+    home = home_command(a["eef_pose"][0, :3])
+    for t in steps_at:
         if t >= repeat:
             w = waypoint[t - repeat]
             previous, age, switch = target[t - repeat], t - first[w], waypoint[t] != w
             following = target[first[w + 1]] if first[w + 1] < steps else previous
             before, count = t - repeat, moves[w] + 1
-            change = previous - (target[first[w - 1]] if w > 0 else home_command(eef[0, :3]))
+            change = previous - (target[first[w - 1]] if w > 0 else home)
         else:  # the first command: the track holds the home pose
-            previous, age, switch, following, before, count = home_command(eef[0, :3]), t, True, target[0], 0, 0
+            previous, age, switch, following, before, count = home, t, True, target[0], 0, 0
             change = np.zeros(7)
-        x = features(roles, eef[t, :3], ee_rot[t], grip[t, 0], grip[t, 1], objects[t, :, :3], obj_rot[t],
-                     (previous, change, eef[t, :3] - eef[before, :3], age, count), assets)
-        xs.append(x)
-        ys.append(np.concatenate([following[:6] - previous[:6], following[6:], [float(switch)]]))
+        label = np.concatenate([following[:6] - previous[:6], following[6:], [float(switch)]])
+        yield t, previous, change, before, age, count, label
+
+
+def samples_of(episode, stride, repeat, assets):
+    """The episode's training rows at every stride-th step t (command_rows): the inputs from the
+    recorded state and the label."""
+    _, scene, a = episode
+    roles = SceneRoles(scene)
+    eef, grip = a["eef_pose"], a["gripper"]
+    steps = len(eef)
+    objects = a["object_poses"].reshape(steps, -1, 7)
+    ee_rot = rotation_of_quaternion(eef[:, 3:])
+    obj_rot = rotation_of_quaternion(objects[..., 3:])
+    xs, ys = [], []
+    for t, previous, change, before, age, count, label in command_rows(a, range(0, steps, stride), repeat):
+        xs.append(features(roles, eef[t, :3], ee_rot[t], grip[t, 0], grip[t, 1], objects[t, :, :3], obj_rot[t],
+                           (previous, change, eef[t, :3] - eef[before, :3], age, count), assets))
+        ys.append(label)
     return xs, ys
 
 
@@ -235,6 +246,15 @@ class Normaliser:
 
     def state(self):
         return {k: v.tolist() for k, v in vars(self).items()}
+
+    def constant_in_own_units(self):
+        """A copy passing the columns that were constant over the training rows (the table's height
+        of ALN's goal, an absent object's zeros) as their deviation unscaled, not divided by
+        __init__'s 1e-6: a model fed inputs that vary there (perceived ones) is not handed a
+        millionfold value. The same model on inputs like its training rows answers the same."""
+        n = Normaliser.of_state(self.state())
+        n.x_std = np.where(n.x_std < 2e-6, 1.0, n.x_std).astype(np.float32)
+        return n
 
     @staticmethod
     def of_state(state):
@@ -322,31 +342,41 @@ def stopped_early(args, epoch, task):
 
 
 def train_task(args, task, torch):
-    path = os.path.join(args.out, f"{task}.pt")
-    checkpoint = path + ".checkpoint"
     data, assets, counts = build_dataset(args.data, task, args.stride, args.repeat)
+    x = data["train"][0]
+    print(f"{task}: {counts['train']} train / {counts['valid']} valid episodes, {len(x)} samples of {x.shape[1]} inputs", flush=True)
+    return fit(args, task, torch, data, os.path.join(args.out, f"{task}.pt"), {"assets": assets, "repeat": args.repeat})
+
+
+def fit(args, task, torch, data, path, start):
+    """Trains a model on data ({"train": (inputs, labels), "valid": ...}) and saves it to path; start:
+    a saved model to go on from (its weights, normaliser, size, assets and repeat), or only the
+    assets and repeat of a new one (the normaliser of data's train rows, --width, --depth)."""
+    checkpoint = path + ".checkpoint"
     x, y = data["train"]
-    norm = Normaliser(x)
+    norm = Normaliser.of_state(start["norm"]) if "model" in start else Normaliser(x)
+    width, depth = (start["width"], start["depth"]) if "model" in start else (args.width, args.depth)
     xt, xn, yt = torch.from_numpy(x), torch.from_numpy(norm(x)), torch.from_numpy(y)
     valid = None
     if "valid" in data:
         vx, vy = data["valid"]
         valid = (torch.from_numpy(norm(vx)), torch.from_numpy(vx), torch.from_numpy(vy))
     torch.manual_seed(args.seed)
-    model = build_model(torch, x.shape[1], args.width, args.depth)
+    model = build_model(torch, x.shape[1], width, depth)
+    if "model" in start:
+        model.load_state_dict(start["model"])
     optimiser = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=args.weight_decay)
     epoch, history = 0, []
     generator = torch.Generator().manual_seed(args.seed)
     if args.resume and os.path.exists(checkpoint):
         epoch, history = resume(torch, checkpoint, model, optimiser, generator, task)
-    print(f"{task}: {counts['train']} train / {counts['valid']} valid episodes, {len(x)} samples of {x.shape[1]} inputs", flush=True)
     t0 = time.perf_counter()
     for epoch in scheduled_epochs(args, epoch, optimiser):
         model.train()
         order = torch.randperm(len(xn), generator=generator)
         total = 0.0
-        for start in range(0, len(order), args.batch):
-            idx = order[start:start + args.batch]
+        for begin in range(0, len(order), args.batch):
+            idx = order[begin:begin + args.batch]
             loss = loss_of(torch, model(xn[idx]), xt[idx], yt[idx])
             optimiser.zero_grad()
             loss.backward()
@@ -362,8 +392,8 @@ def train_task(args, task, torch):
         write_checkpoint(torch, checkpoint, model, optimiser, generator, epoch, history)
     if stopped_early(args, epoch, task):
         return None
-    save(torch, {"model": model.state_dict(), "inputs": x.shape[1], "width": args.width, "depth": args.depth,
-                 "norm": norm.state(), "assets": assets, "task": task, "history": history, "repeat": args.repeat}, path)
+    save(torch, {"model": model.state_dict(), "inputs": x.shape[1], "width": width, "depth": depth, "norm": norm.state(),
+                 "assets": start["assets"], "task": task, "history": history, "repeat": start["repeat"]}, path)
     print(f"{task}: model -> {path}", flush=True)
     return model
 
@@ -377,6 +407,14 @@ def train(args, train_one=None):
 
 
 # ---- acting (evaluate.py: python:manisoft.reference_policy:act)
+
+def observed_features(obs, roles, memory, assets):
+    """features() of an observation (evaluate.py's privileged one: end_effector, gripper_width,
+    gripper_state, object_poses)."""
+    ee, poses = np.asarray(obs["end_effector"]), np.asarray(obs["object_poses"])
+    return features(roles, ee[:3, 3], ee[:3, :3], float(obs["gripper_width"]), float(obs["gripper_state"]), poses[:, :3, 3],
+                    poses[:, :3, :3], memory, assets)
+
 
 class Policy:
     """One task's model and its memory of the episode: its previous command, the end effector's
@@ -400,13 +438,10 @@ class Policy:
         self.age = self.moves = 0
 
     def __call__(self, obs, roles):
-        ee = np.asarray(obs["end_effector"])
-        p, r = ee[:3, 3], ee[:3, :3]
+        p = np.asarray(obs["end_effector"])[:3, 3]
         if self.previous is None:
             self.previous, self.position = home_command(p), p.copy()
-        poses = np.asarray(obs["object_poses"])
-        x = features(roles, p, r, float(obs["gripper_width"]), float(obs["gripper_state"]), poses[:, :3, 3], poses[:, :3, :3],
-                     (self.previous, self.change, p - self.position, self.age, self.moves), self.assets)
+        x = observed_features(obs, roles, (self.previous, self.change, p - self.position, self.age, self.moves), self.assets)
         torch = self.torch
         x = x.astype(np.float32)[None]
         with torch.no_grad():

@@ -187,6 +187,73 @@ class ImagePolicyTest(unittest.TestCase):
         self.assertEqual(ip.task_of("Place the shoe at the marker.", models), "ALN")
         self.assertEqual(ip.task_of("Put it into the basket, please.", models), "COLL")
 
+    def test_the_head_adapted_to_perception_trains_on_what_acting_reads(self):
+        heads, adapted = os.path.join(self.dir, "adapt_heads"), os.path.join(self.dir, "adapted")
+        rp.main(["train", "--data", self.data, "--out", heads, "--tasks", "ALN", "--epochs", "2", "--batch", "64", "--width", "64",
+                 "--stride", "8", "--threads", "1"])
+        pairs = [f"{self.data}:{self.images}"]
+        perception = ip.Perception(os.path.join(self.models, "ALN.perception.pt"), torch)
+        head = torch.load(os.path.join(heads, "ALN.pt"))
+        rows, counts = ip.perceived_rows(ip.perceived_reads(pairs, "ALN", perception, 36), perception, head)
+        self.assertEqual(counts["train"] + counts["valid"], 5)
+        # each row: what act() hands the head for that frame, the frames read one at a time in order
+        # (the resting object until the expert's command closes the gripper; the previous command and
+        # its age the expert's), and the label the privileged training's row at that step
+        mask, scene, a, frames, steps, said, _ = next(ip.rendered_episodes(pairs, "ALN"))
+        self.assertEqual(mask, "train")
+        np.testing.assert_array_equal(steps, np.arange(len(steps)) * 36)
+        xs, ys = rp.samples_of((mask, scene, a), 36, 36, head["assets"])
+        self.assertEqual(len(xs), len(frames))
+        perception.reset()
+        closed = False
+        for i, frame in enumerate(frames):
+            previous = rp.home_command(a["eef_pose"][0, :3]) if i == 0 else a["ee_target"][steps[i] - 36]
+            closed = closed or previous[6] >= 0.5
+            y, asset = perception(frame, said[0], resting=not closed)
+            seen, roles = ip.seen_observation(perception, y, asset, float(previous[6] >= 0.5), previous if i else None)
+            x = rp.observed_features(seen, roles, (previous, np.zeros(7), np.zeros(3), 0, 0), head["assets"])
+            # the end effector where seen_observation puts it, width, S and the previous command from it; the label
+            np.testing.assert_allclose(rows["train"][0][i, :13], x[:13].astype(np.float32), atol=1e-4)
+            np.testing.assert_allclose(rows["train"][1][i], ys[i].astype(np.float32), atol=1e-6)
+        # the adapted model starts from the privileged one and lowers the loss on these rows
+        ip.main(["adapt", "--data", pairs[0], "--perception", self.models, "--reference", heads, "--out", adapted, "--tasks", "ALN",
+                 "--epochs", "4", "--batch", "16", "--lr", "1e-3", "--threads", "1"])
+        saved = torch.load(os.path.join(adapted, "ALN.head.pt"))
+        norm = rp.Normaliser.of_state(head["norm"]).constant_in_own_units()
+        self.assertEqual((saved["norm"], saved["assets"], saved["repeat"]), (norm.state(), head["assets"], head["repeat"]))
+        losses = [train for _, train, _ in saved["history"]]
+        model = rp.build_model(torch, head["inputs"], head["width"], head["depth"])
+        model.load_state_dict(head["model"])
+        x, y = rows["train"]
+        with torch.no_grad():
+            before = rp.loss_of(torch, model(torch.from_numpy(norm(x))), torch.from_numpy(x), torch.from_numpy(y)).item()
+        self.assertLess(losses[-1], 0.7 * before, (before, losses))
+        # acting, the adapted head beside the perception is used: no reference models needed
+        for name in ("ALN.perception.pt", "ALN.refine.pt"):
+            shutil.copy(os.path.join(self.models, name), adapted)
+        saved_env = {k: os.environ.pop(k, None) for k in ("MANISOFT_REFERENCE_MODELS", "MANISOFT_PERCEPTION_MODELS")}
+        os.environ["MANISOFT_PERCEPTION_MODELS"] = adapted
+        ip._perception.clear()
+        ip._heads.clear()
+        try:
+            out = os.path.join(self.dir, "eval_adapted")
+            self.assertEqual(evaluate.main(["--task", "ALN", "--setting", "clean", "--policy", "python:image_policy:act",
+                                            "--action-mode", "ee_pose", "--image-size", "384", "384", "--indices", "0",
+                                            "--out", out]), 0)
+            with open(os.path.join(out, "episodes.jsonl")) as f:
+                episode = json.loads(f.readline())
+            self.assertNotIn(episode["failure"], ("policy_error", "bad_action", "policy_timeout"), episode)
+        finally:
+            ip._perception.clear()
+            ip._heads.clear()
+            for k, v in saved_env.items():
+                os.environ.pop(k, None)
+                if v is not None:
+                    os.environ[k] = v
+        # frames not every repeat control steps are refused, saying how to render them
+        with self.assertRaisesRegex(ValueError, "acts every 72 control steps from step 0; render with render_dataset --every 72"):
+            next(ip.perceived_reads(pairs, "ALN", perception, 72))
+
     def test_evaluate_runs_it_from_the_image_on_the_end_effector_track(self):
         heads = os.path.join(self.dir, "heads")
         rp.main(["train", "--data", self.data, "--out", heads, "--tasks", "ALN", "--epochs", "3", "--batch", "64", "--width", "64",
@@ -202,6 +269,35 @@ class ImagePolicyTest(unittest.TestCase):
         # a model this small fails the episode; it must fail it by the task, never by the policy
         self.assertNotIn(episodes[0]["failure"], ("policy_error", "bad_action", "policy_timeout"), episodes[0])
         self.assertGreater(episodes[0]["steps"], 36)
+
+
+class SeenObservationTest(unittest.TestCase):
+    def test_the_end_effector_is_taken_on_its_ray_nearest_the_last_command_when_close(self):
+        # a camera 1 m above the origin: the ray through a perceived end effector at the origin is the
+        # z axis; the command's nearest point on it is the command's height
+        perception = type("P", (), {"task": "ALN", "model_camera": type("C", (), {"position": np.array([0.0, 0.0, 1.0])})()})()
+        y = np.zeros(ip.ANSWER)
+        y[3:9] = [1, 0, 0, 0, 1, 0]
+        y[13:19] = y[22:28] = [1, 0, 0, 0, 1, 0]
+        command = np.array([0.03, -0.02, 0.05, 0, 0, 0, 0])
+        seen, _ = ip.seen_observation(perception, y, "shoe/00", 0.0, command)
+        np.testing.assert_allclose(seen["end_effector"][:3, 3], [0.0, 0.0, 0.05], atol=1e-12)
+        command[2] = ip.NEAR + 0.01  # its nearest point farther than NEAR from the perceived one: kept
+        seen, _ = ip.seen_observation(perception, y, "shoe/00", 0.0, command)
+        np.testing.assert_allclose(seen["end_effector"][:3, 3], [0.0, 0.0, 0.0])
+        seen, _ = ip.seen_observation(perception, y, "shoe/00", 0.0, None)  # before the first command
+        np.testing.assert_allclose(seen["end_effector"][:3, 3], [0.0, 0.0, 0.0])
+
+    def test_columns_constant_in_training_pass_their_deviation_unscaled(self):
+        x = np.array([[0.1, 0.75, 2.0], [0.3, 0.75, 4.0], [0.2, 0.75, 3.0]], dtype=np.float32)
+        norm = rp.Normaliser(x)
+        self.assertLess(norm.x_std[1], 2e-6)
+        own = norm.constant_in_own_units()
+        np.testing.assert_allclose(own.x_std, [norm.x_std[0], 1.0, norm.x_std[2]])
+        np.testing.assert_allclose(own(x), norm(x), atol=1e-6)  # the training rows: the same inputs
+        off = x[:1] + np.array([[0.0, 0.002, 0.0]], dtype=np.float32)  # the table's height read 2 mm off
+        self.assertAlmostEqual(float(own(off)[0, 1]), 0.002, places=5)
+        self.assertGreater(float(norm(off)[0, 1]), 1000.0)
 
 
 if __name__ == "__main__":
