@@ -2,14 +2,16 @@
 """The reference policy from the image and the instruction on the end-effector track: a perception
 network (a small CNN trained from scratch, the instruction embedded) reads off the camera image
 what the privileged reference policy (reference_policy.py) reads from the state, and that policy's
-trained model acts on it. It sees what the paper's policies see, the image and the instruction,
-plus its own previous commands.
+model, trained further on what the perception reads (adapt), acts on it. It sees what the paper's
+policies see, the image and the instruction, plus its own previous commands.
 
     generate_dataset --tasks ALN,COLL --clean 1000 --randomized 1000 --seed 1 --out data/ref2
     render_dataset data/ref2 --out img/ref2 --every 36 --image-size 384 384
     /usr/bin/python3 -m manisoft.image_policy train --data data/ref2:img/ref2 --tasks ALN,COLL --out img/models
     /usr/bin/python3 -m manisoft.image_policy refine --data data/ref2:img/ref2 --perception img/models --tasks ALN,COLL --out img/models
-    MANISOFT_REFERENCE_MODELS=ref/models MANISOFT_PERCEPTION_MODELS=img/models /usr/bin/python3 -m manisoft.evaluate \\
+    /usr/bin/python3 -m manisoft.image_policy adapt --data data/ref2:img/ref2 --perception img/models --reference ref/models \\
+        --tasks ALN,COLL --out img/models
+    MANISOFT_PERCEPTION_MODELS=img/models /usr/bin/python3 -m manisoft.evaluate \\
         --task ALN --setting all --policy python:manisoft.image_policy:act --action-mode ee_pose --image-size 384 384 --out img/eval
 
 Perception: the image's table region (CROP, fractions of the image) at 96 x 96 pixels with two
@@ -36,8 +38,14 @@ the located point. While the policy has not closed the gripper the moved object 
 table, at the height of training's resting objects.
 Acting: the static parts of the scene (the container or goal, the obstacle, the asset) are averaged
 over the episode's frames so far (a refined marker: the median); the end effector, the fingers and the moved object are read from
-the current frame; S is the policy's own last command. The task is the one whose training
-instructions make the instruction's words likeliest (naive Bayes over the words).
+the current frame, the end effector moved along its camera ray to the point nearest the last
+command where that is within NEAR (the arm settles at its command; one view's height is the least
+certain); S is the policy's own last command. The task is the one whose training instructions make
+the instruction's words likeliest (naive Bayes over the words).
+Adapting (adapt; used where <TASK>.head.pt lies beside <TASK>.perception.pt, else
+$MANISOFT_REFERENCE_MODELS/<TASK>.pt acts): the privileged model trained further on rows whose
+state is what perception reads off each rendered frame as when acting, the memory and labels the
+expert's commands; the columns constant over the privileged rows pass their deviation unscaled.
 """
 import argparse
 import glob
@@ -687,10 +695,12 @@ def train_refiners(args):
     return train(args, refine_task)
 
 
-def perceived_reads(pairs, task, perception, repeat):
-    """Perception.read of each rendered episode of the task: (mask, the recorded arrays, the frames'
-    control steps, the episode's canonical instruction, read's rows)."""
-    for mask, _, a, frames, steps, said, _ in rendered_episodes(pairs, task):
+def perceived_reads(pairs, task, perception, repeat, settings=("clean", "randomized")):
+    """Perception.read of each rendered episode of the task in one of the settings: (mask, the
+    recorded arrays, the frames' control steps, the episode's canonical instruction, read's rows)."""
+    for mask, scene, a, frames, steps, said, _ in rendered_episodes(pairs, task):
+        if scene["setting"] not in settings:
+            continue
         if len(steps) and (steps[0] != 0 or np.any(np.diff(steps) != repeat)):
             raise ValueError(f"{task} frames at steps {', '.join(map(str, steps[:3]))}, ...: the head acts every {repeat} "
                              f"control steps from step 0; render with render_dataset --every {repeat}")
@@ -726,9 +736,10 @@ def adapt_task(args, task, torch):
     head["norm"] = rp.Normaliser.of_state(head["norm"]).constant_in_own_units().state()
     perception = Perception(os.path.join(args.perception, f"{task}.perception.pt"), torch)
     t0 = time.perf_counter()
-    data, counts = perceived_rows(perceived_reads(args.data, task, perception, head["repeat"]), perception, head)
+    settings = ("clean", "randomized") if args.setting == "all" else (args.setting,)
+    data, counts = perceived_rows(perceived_reads(args.data, task, perception, head["repeat"], settings), perception, head)
     if "train" not in data:
-        raise ValueError(f"{', '.join(args.data)}: no rendered {task} frames of train-mask episodes")
+        raise ValueError(f"{', '.join(args.data)}: no rendered {task} frames of train-mask episodes ({args.setting} scenes)")
     print(f"{task}: {counts['train']} train / {counts['valid']} valid episodes, {len(data['train'][0])} train frames read "
           f"in {time.perf_counter() - t0:.0f} s", flush=True)
     return rp.fit(args, task, torch, data, os.path.join(args.out, f"{task}.head.pt"), head)
@@ -1007,6 +1018,9 @@ def main(argv=None):
     h.add_argument("--reference", required=True, help="reference_policy.py train's directory (<TASK>.pt, where it starts)")
     h.add_argument("--out", required=True, help="directory for <TASK>.head.pt (put it beside <TASK>.perception.pt to use it)")
     h.add_argument("--tasks", default="ALN")
+    h.add_argument("--setting", choices=("clean", "randomized", "all"), default="clean",
+                   help="the scenes whose frames it trains on (randomized scenes' perceived state is far off; trained on "
+                   "them too the head does worse on both)")
     h.add_argument("--epochs", type=int, default=10)
     h.add_argument("--batch", type=int, default=512)
     h.add_argument("--lr", type=float, default=3e-4)

@@ -196,6 +196,7 @@ class ImagePolicyTest(unittest.TestCase):
         head = torch.load(os.path.join(heads, "ALN.pt"))
         rows, counts = ip.perceived_rows(ip.perceived_reads(pairs, "ALN", perception, 36), perception, head)
         self.assertEqual(counts["train"] + counts["valid"], 5)
+        self.assertEqual(len(list(ip.perceived_reads(pairs, "ALN", perception, 36, ("randomized",)))), 1)  # of 4 clean, 1 randomized
         # each row: what act() hands the head for that frame, the frames read one at a time in order
         # (the resting object until the expert's command closes the gripper; the previous command and
         # its age the expert's), and the label the privileged training's row at that step
