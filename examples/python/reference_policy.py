@@ -495,15 +495,16 @@ def curves(args):
     for path in args.models:
         saved = torch.load(path)
         epochs, train_loss, held_out = zip(*saved["history"])
-        line, = ax.plot(epochs, train_loss, label=f"{saved['task']} train")
+        name = os.path.basename(path)
+        line, = ax.plot(epochs, train_loss, label=f"{name} train")
         if all(h is not None for h in held_out):
-            ax.plot(epochs, held_out, "--", color=line.get_color(), label=f"{saved['task']} held-out (valid mask)")
+            ax.plot(epochs, held_out, "--", color=line.get_color(), label=f"{name} held-out (valid mask)")
     ax.set_xlabel("epoch")
     ax.set_ylabel("loss (log scale)")
     ax.set_yscale("log")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    ax.set_title("Reference policy (privileged state, end-effector track): learning curves", fontsize=9)
+    ax.set_title("Reference policy (end-effector track): learning curves", fontsize=9)
     fig.tight_layout()
     save_figure(fig, args.out)
 
