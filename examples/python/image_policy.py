@@ -721,7 +721,7 @@ def perceived_rows(reads, perception, head):
         for i, (_, previous, change, _, age, count, label) in enumerate(rp.command_rows(a, steps, head["repeat"])):
             s = float(previous[6] >= 0.5)
             closed = closed or s > 0
-            y, asset = perception.fold(out[i], refined and tuple(None if r is None else r[i] for r in refined), not closed)
+            y, asset = perception.fold(out[i], frame_of(refined, i), not closed)
             seen, roles = seen_observation(perception, y, asset, s, previous if i else None)
             ee = seen["end_effector"][:3, 3]
             moved = np.zeros(3) if last is None else ee - last
@@ -830,7 +830,12 @@ class Perception:
     def __call__(self, image, instruction, resting=False):
         """fold of read of one image."""
         out, refined = self.read([image], instruction)
-        return self.fold(out[0], refined and tuple(None if r is None else r[0] for r in refined), resting)
+        return self.fold(out[0], frame_of(refined, 0), resting)
+
+
+def frame_of(refined, i):
+    """Frame i's entries of Perception.read's refined rows (None without a refinement)."""
+    return refined and tuple(None if r is None else r[i] for r in refined)
 
 
 def task_of(instruction, models):
@@ -1012,7 +1017,7 @@ def main(argv=None):
         stage.add_argument("--word-drop", type=float, default=0.15, help="the chance a training instruction's word is replaced by 'unknown'")
         rp.add_run_flags(stage)
     h = sub.add_parser("adapt", help="train the privileged policy's model further on the state perception reads off the "
-                       "rendered frames (frames every --repeat control steps), as <TASK>.head.pt used beside the perception")
+                       "rendered frames (a frame every 36 control steps, the model's rate), as <TASK>.head.pt used beside the perception")
     h.add_argument("--data", required=True, action="append", help="DATASET_DIR:IMAGES_DIR, as refine's")
     h.add_argument("--perception", required=True, help="the perception's directory (<TASK>.perception.pt, <TASK>.refine.pt)")
     h.add_argument("--reference", required=True, help="reference_policy.py train's directory (<TASK>.pt, where it starts)")
