@@ -914,10 +914,11 @@ def act(obs):
         _episode["task"] = task_of(instruction, _perception)
     task = _episode["task"]
     if task not in _heads:
-        adapted = os.path.join(os.environ["MANISOFT_PERCEPTION_MODELS"], f"{task}.head.pt")
-        if not os.path.exists(adapted) and not os.environ.get("MANISOFT_REFERENCE_MODELS"):
-            raise RuntimeError(f"no {adapted}: set MANISOFT_REFERENCE_MODELS (reference_policy.py train's directory)")
-        path = adapted if os.path.exists(adapted) else os.path.join(os.environ["MANISOFT_REFERENCE_MODELS"], f"{task}.pt")
+        path = os.path.join(os.environ["MANISOFT_PERCEPTION_MODELS"], f"{task}.head.pt")
+        if not os.path.exists(path):
+            if not os.environ.get("MANISOFT_REFERENCE_MODELS"):
+                raise RuntimeError(f"no {path}: set MANISOFT_REFERENCE_MODELS (reference_policy.py train's directory)")
+            path = os.path.join(os.environ["MANISOFT_REFERENCE_MODELS"], f"{task}.pt")
         _heads[task] = rp.Policy(path, torch)
     head = _heads[task]
     s = 0.0 if head.previous is None else float(head.previous[6] >= 0.5)
@@ -1026,12 +1027,7 @@ def main(argv=None):
     h.add_argument("--setting", choices=("clean", "randomized", "all"), default="clean",
                    help="the scenes whose frames it trains on (randomized scenes' perceived state is far off; trained on "
                    "them too the head does worse on both)")
-    h.add_argument("--epochs", type=int, default=10)
-    h.add_argument("--batch", type=int, default=512)
-    h.add_argument("--lr", type=float, default=3e-4)
-    h.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
-    h.add_argument("--weight-decay", type=float, default=1e-4)
-    rp.add_run_flags(h)
+    rp.add_fit_flags(h, epochs=10, lr=3e-4)
     c = sub.add_parser("curves", help="plot the held-out position errors per epoch of trained models")
     c.add_argument("models", nargs="+", help="<TASK>.perception.pt and <TASK>.refine.pt files (or their .checkpoint)")
     c.add_argument("--out", required=True, help="PNG file")

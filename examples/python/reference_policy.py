@@ -322,6 +322,16 @@ def add_run_flags(parser):
                         "job), leaving the checkpoint for --resume")
 
 
+def add_fit_flags(parser, epochs, lr):
+    """fit's flags (and add_run_flags'), with the command's default epochs and learning rate."""
+    parser.add_argument("--epochs", type=int, default=epochs)
+    parser.add_argument("--batch", type=int, default=512)
+    parser.add_argument("--lr", type=float, default=lr)
+    parser.add_argument("--weight-decay", type=float, default=1e-4)
+    parser.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
+    add_run_flags(parser)
+
+
 def scheduled_epochs(args, epoch, optimiser):
     """The epochs this run trains, from a resumed run's epoch to --epochs (or --stop-after more), each
     with its learning rate set first (falling by --lr-decay over the whole schedule): yields each
@@ -516,16 +526,11 @@ def main(argv=None):
     t.add_argument("--data", required=True, action="append", help="a dataset directory written by generate_dataset (repeat for more)")
     t.add_argument("--out", required=True, help="directory for <TASK>.pt")
     t.add_argument("--tasks", default="ALN,COLL")
-    t.add_argument("--epochs", type=int, default=30)
-    t.add_argument("--batch", type=int, default=512)
-    t.add_argument("--lr", type=float, default=1e-3)
-    t.add_argument("--weight-decay", type=float, default=1e-4)
-    t.add_argument("--lr-decay", type=float, default=0.1, help="the learning rate falls by this factor over the run")
+    add_fit_flags(t, epochs=30, lr=1e-3)
     t.add_argument("--width", type=int, default=256)
     t.add_argument("--depth", type=int, default=3)
     t.add_argument("--stride", type=int, default=2, help="a sample every this many control steps")
     t.add_argument("--repeat", type=int, default=36, help="control steps between the policy's commands")
-    add_run_flags(t)
     c = sub.add_parser("curves", help="plot the learning curves of trained models")
     c.add_argument("models", nargs="+", help="<TASK>.pt files")
     c.add_argument("--out", required=True, help="PNG file")
